@@ -1,0 +1,113 @@
+// Earth model: WGS-84 ellipsoid, radii of curvature, normal gravity, Earth and transport rates,
+// and conversions between geodetic (LLH), Earth-centred Earth-fixed (ECEF) and local NED
+// coordinates. Also the flat local frame with constant gravity used by seed 000.
+//
+// Frames: e = ECEF, n = local-level NED at the body, b = body (forward-right-down).
+// Units: SI (metres, seconds, radians). Latitude L_b, longitude lambda_b, height h_b above the
+// ellipsoid.
+//
+// References: NIMA TR8350.2 (WGS-84, 3rd ed., 2000); Groves, "Principles of GNSS, Inertial, and
+// Multisensor Integrated Navigation Systems", 2nd ed. (2013), sections 2.4 and 2.4.7.
+#pragma once
+
+#include <Eigen/Core>
+
+namespace driftlab {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+// WGS-84 defining and derived constants (NIMA TR8350.2 tables 3.1 and 3.3).
+inline constexpr double kWgs84SemiMajorAxis_m = 6378137.0;            // a, R_0
+inline constexpr double kWgs84Flattening = 1.0 / 298.257223563;       // f
+inline constexpr double kWgs84Eccentricity2 =                          // e^2 = f (2 - f)
+    kWgs84Flattening * (2.0 - kWgs84Flattening);
+inline constexpr double kWgs84SemiMinorAxis_m =                        // b = a (1 - f)
+    kWgs84SemiMajorAxis_m * (1.0 - kWgs84Flattening);
+inline constexpr double kWgs84EarthRate_rad_per_s = 7.292115e-5;       // omega_ie
+inline constexpr double kWgs84GM_m3_per_s2 = 3.986004418e14;           // mu
+inline constexpr double kWgs84GammaEquator_m_per_s2 = 9.7803253359;    // normal gravity, L = 0
+inline constexpr double kWgs84GammaPole_m_per_s2 = 9.8321849378;       // normal gravity, L = 90 deg
+
+// Standard gravity (CGPM 1901), used only for converting g-based datasheet units.
+inline constexpr double kStandardGravity_m_per_s2 = 9.80665;
+
+// Meridian radius of curvature R_N(L) = a (1 - e^2) / (1 - e^2 sin^2 L)^(3/2). Groves (2.105).
+double MeridianRadius(double L_b);
+// Transverse (prime-vertical) radius of curvature R_E(L) = a / sqrt(1 - e^2 sin^2 L). Groves (2.106).
+double TransverseRadius(double L_b);
+
+// Magnitude of normal gravity on the ellipsoid surface, Somigliana's closed formula
+// gamma_0(L) = gamma_e (1 + k sin^2 L) / sqrt(1 - e^2 sin^2 L), k = b gamma_p / (a gamma_e) - 1.
+// Groves (2.134).
+double SomiglianaGravity(double L_b);
+
+// Gravity (gravitation plus centrifugal) resolved in NED at latitude L_b and height h_b:
+//   g_D = gamma_0(L) [1 - 2/a (1 + f (1 - 2 sin^2 L) + omega_ie^2 a^2 b / mu) h + 3 h^2 / a^2]
+//   g_N = -8.08e-9 h sin 2L, g_E = 0.
+// Groves (2.139)-(2.140). Valid for heights well below 10 km of ellipsoid (free-air expansion).
+Vector3d GravityNed(double L_b, double h_b);
+
+// Earth rotation rate resolved in NED: omega_ie_n = omega_ie [cos L, 0, -sin L]^T. Groves (5.41).
+Vector3d EarthRateNed(double L_b);
+
+// Transport rate, the turn rate of NED with respect to ECEF caused by motion over the curved
+// Earth: omega_en_n = [v_E/(R_E+h), -v_N/(R_N+h), -v_E tan L/(R_E+h)]^T. Groves (5.44).
+Vector3d TransportRateNed(double L_b, double h_b, const Vector3d& v_eb_n);
+
+// Geodetic latitude, longitude, height.
+struct Llh {
+  double lat_rad = 0.0;
+  double lon_rad = 0.0;
+  double h_m = 0.0;
+};
+
+// Geodetic to ECEF position. Groves (2.112).
+Vector3d LlhToEcef(const Llh& llh);
+// ECEF position to geodetic; iterated to machine precision (converges in <= 6 iterations for
+// any point above -1000 km of height). Groves section 2.4.2, Bowring initial guess.
+Llh EcefToLlh(const Vector3d& r_eb_e);
+// Rotation from ECEF to local NED at (L, lambda). Groves (2.150).
+Matrix3d EcefToNedDcm(double L_b, double lambda_b);  // C_e_n
+// NED displacement of point `p` relative to the reference point `ref`, through ECEF
+// (exact, no small-distance approximation).
+Vector3d LlhToNed(const Llh& p, const Llh& ref);
+// Inverse of LlhToNed.
+Llh NedToLlh(const Vector3d& r_n, const Llh& ref);
+
+// Earth model selected for a job.
+enum class EarthModel {
+  kWgs84,  // ellipsoid, normal gravity with height, Earth rotation
+  kFlat,   // seed 000: flat local frame, constant gravity, no Earth rotation or transport rate
+};
+
+// Navigation-frame environment queried by the generator and the mechanizations, so that both see
+// exactly the same physics. For kFlat, the geodetic coordinates map to metres through constant
+// radii frozen at the reference point (a local tangent plane), gravity is
+// [0, 0, gravity_m_per_s2] and the rotation rates are zero.
+class NavEnvironment {
+ public:
+  static NavEnvironment Wgs84();
+  static NavEnvironment Flat(const Llh& reference, double gravity_m_per_s2);
+
+  EarthModel model() const { return model_; }
+  // Radii used for d(L)/dt = v_N / (R_N + h) and d(lambda)/dt = v_E / ((R_E + h) cos L).
+  double MeridianRadiusAt(double L_b) const;
+  double TransverseRadiusAt(double L_b) const;
+  Vector3d Gravity(double L_b, double h_b) const;                 // g_b_n
+  Vector3d EarthRate(double L_b) const;                           // omega_ie_n
+  Vector3d TransportRate(double L_b, double h_b, const Vector3d& v_eb_n) const;  // omega_en_n
+  // Rate of change of (L, lambda, h) for NED velocity v_eb_n. Groves (2.111).
+  Vector3d LlhRate(double L_b, double h_b, const Vector3d& v_eb_n) const;
+  // Position error of `estimate` relative to `truth`, in metres along N, E, D at the truth point,
+  // using the curvilinear-to-metre scaling of this environment.
+  Vector3d PositionErrorNed(const Llh& estimate, const Llh& truth) const;
+
+ private:
+  EarthModel model_ = EarthModel::kWgs84;
+  double flat_R_N_m_ = 0.0;
+  double flat_R_E_m_ = 0.0;
+  double flat_gravity_m_per_s2_ = 0.0;
+};
+
+}  // namespace driftlab

@@ -1,0 +1,218 @@
+// Trajectory generator: a motion (initial state + segments, or an imported motion file) turned
+// into a truth trajectory and ideal IMU data at a fixed output rate.
+//
+// Physics. Every segment defines the vehicle's Euler angles and NED velocity as smooth functions
+// of time with analytic first derivatives (continuous across segment boundaries). From them:
+//   omega_ib_b = omega_nb_b + C_n_b (omega_ie_n + omega_en_n)                   Groves (5.40)
+//   f_ib_b     = C_n_b (dv_eb_n/dt - g_b_n + (omega_en_n + 2 omega_ie_n) x v_eb_n)   Groves (5.54)
+// with omega_nb_b from the Euler-angle rates. Position (L, lambda, h) is integrated from the
+// velocity with Groves (2.111). Ideal IMU increments are the integrals of omega_ib_b and f_ib_b over
+// each output interval, computed with Gauss-Legendre quadrature on internal sub-steps that are
+// split at every breakpoint of the kinematics, so they are exact to rounding for the smooth pieces
+// (and therefore contain the coning and sculling a real integrating IMU sees).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "driftlab/attitude.h"
+#include "driftlab/earth.h"
+#include "driftlab/nav_state.h"
+
+namespace driftlab {
+
+// ---- Motion definition -------------------------------------------------------------------------
+
+struct InitialState {
+  Llh llh;                               // [rad, rad, m]
+  Vector3d v_eb_n = Vector3d::Zero();    // [m/s] NED
+  EulerAngles attitude;                  // [rad]
+};
+
+// How the vehicle's attitude follows its velocity in the parametric segments.
+struct VehicleOptions {
+  // Aircraft: bank angle phi = atan(V * turn_rate / g) in turns (coordinated turn).
+  // Cars and ships: no bank in turns.
+  bool coordinated_turns = false;
+  // Aircraft: pitch follows the flight-path angle atan2(v_up, ground speed) in climbs.
+  bool pitch_follows_flight_path = false;
+};
+
+// Hold still (speed must be zero when it starts).
+struct StaticSegment {
+  double duration_s = 0.0;
+};
+
+// Change along-track speed at a constant rate; heading, vertical speed and attitude held.
+// Exactly one of duration_s or target_speed_m_per_s is set; acceleration_m_per_s2 > 0 is the
+// magnitude, the sign follows from the target (or, with duration_s, is given by `decelerate`).
+struct AccelerateSegment {
+  double acceleration_m_per_s2 = 0.0;
+  std::optional<double> target_speed_m_per_s;
+  std::optional<double> duration_s;
+  bool decelerate = false;  // only with duration_s
+};
+
+struct ConstantVelocitySegment {
+  double duration_s = 0.0;
+};
+
+// Turn at a constant rate (positive = clockwise seen from above, i.e. yaw increasing) entered and
+// left with a linear ramp of the turn rate over transition_s. Rate given directly or by radius and
+// direction at the current ground speed. Length given by the heading change or by duration.
+struct TurnSegment {
+  std::optional<double> rate_rad_per_s;
+  std::optional<double> radius_m;  // with `right`
+  bool right = true;
+  std::optional<double> angle_rad;  // total heading change magnitude, > 0
+  std::optional<double> duration_s;
+  double transition_s = 0.0;
+};
+
+// Climb (climb_rate_m_per_s > 0) or descend (< 0): vertical speed ramps from its current value to
+// the climb rate at vertical_acceleration_m_per_s2, holds, and ramps back, so that the height
+// changes by height_change_m (or for duration_s in total).
+struct ClimbSegment {
+  double climb_rate_m_per_s = 0.0;
+  double vertical_acceleration_m_per_s2 = 0.5;
+  std::optional<double> height_change_m;
+  std::optional<double> duration_s;
+};
+
+// S-shaped weave (seed 002's zigzag): track angle chi = chi_0 + A sin(2 pi t / period), with the
+// heading amplitude A set from the lateral amplitude: lateral half-excursion = V A period / (2 pi).
+struct ZigzagSegment {
+  double amplitude_m = 0.0;
+  double period_s = 0.0;
+  double duration_s = 0.0;
+};
+
+// Ship in a seaway (seed 000's vessel): sinusoidal roll, pitch, yaw and heave superimposed on the
+// current motion, faded in and out with a raised-cosine envelope over ramp_s so that attitude and
+// velocity stay continuous. heave is displacement, positive up.
+struct ShipMotionSegment {
+  double duration_s = 0.0;
+  double roll_amplitude_rad = 0.0, roll_period_s = 1.0, roll_phase_rad = 0.0;
+  double pitch_amplitude_rad = 0.0, pitch_period_s = 1.0, pitch_phase_rad = 0.0;
+  double yaw_amplitude_rad = 0.0, yaw_period_s = 1.0, yaw_phase_rad = 0.0;
+  double heave_amplitude_m = 0.0, heave_period_s = 1.0, heave_phase_rad = 0.0;
+  double ramp_s = 0.0;
+};
+
+// Figure-eight: a full circle one way, then a full circle the other, at the current speed.
+struct FigureEightSegment {
+  std::optional<double> radius_m;
+  std::optional<double> rate_rad_per_s;  // magnitude
+  double transition_s = 0.0;
+  int loops = 1;  // number of figure-eights
+};
+
+// One command line of a gnss-ins-sim motion-definition file (after the initial-state line).
+// Angles are converted to radians; the file's column order is (yaw, pitch, roll) and the velocity
+// is in the body frame.
+struct GnssInsSimCommand {
+  int type = 1;                        // 1..5, gnss-ins-sim's documented meaning
+  Vector3d euler_ypr = Vector3d::Zero();  // rad or rad/s depending on type (yaw, pitch, roll)
+  Vector3d v_b = Vector3d::Zero();        // m/s or m/s^2 depending on type
+  double duration_s = 0.0;             // duration (type 1) or maximum duration (types 2-5)
+  bool gps_visible = true;
+};
+
+// Limits that gnss-ins-sim applies to commands of types 2-5 (its documented defaults).
+struct GnssInsSimLimits {
+  double max_acceleration_m_per_s2 = 10.0;
+  double max_angular_acceleration_rad_per_s2 = 0.5 * M_PI / 180.0;
+  double max_angular_rate_rad_per_s = 2.0 * M_PI / 180.0;
+};
+
+// A truth profile (Groves' motion-profile layout): samples of time, LLH, NED velocity, attitude.
+// The kinematics between samples are the C^2 cubic-spline interpolants of velocity and Euler angles;
+// position is integrated from the interpolated velocity (the file's positions are only checked).
+struct TruthProfileSample {
+  double t_s = 0.0;
+  Llh llh;
+  Vector3d v_eb_n = Vector3d::Zero();
+  EulerAngles attitude;
+};
+
+using Segment = std::variant<StaticSegment, AccelerateSegment, ConstantVelocitySegment, TurnSegment,
+                             ClimbSegment, ZigzagSegment, ShipMotionSegment, FigureEightSegment,
+                             GnssInsSimCommand>;
+
+struct MotionSpec {
+  EarthModel earth_model = EarthModel::kWgs84;
+  // Flat frame only: the constant gravity; if unset, normal gravity at the initial point.
+  std::optional<double> flat_gravity_m_per_s2;
+  InitialState initial;
+  VehicleOptions vehicle;
+  std::vector<Segment> segments;      // parametric / gnss-ins-sim commands, in order
+  GnssInsSimLimits gnss_ins_sim_limits;
+  std::vector<TruthProfileSample> truth_profile;  // if non-empty: the whole motion (no segments)
+  // Field-path prefix used in SpecError messages, e.g. "motion".
+  std::string field_path = "motion";
+};
+
+// Output-rate limits of the generator (issue 2: 1-2000 Hz, durations up to 100,000 s).
+inline constexpr double kMinRate_hz = 1.0;
+inline constexpr double kMaxRate_hz = 2000.0;
+inline constexpr double kMaxDuration_s = 100000.0;
+
+// ---- Generated data ----------------------------------------------------------------------------
+
+// One output step k >= 1: the truth at t_k, the ideal increment over (t_{k-1}, t_k], and the point
+// sample at t_k.
+struct TrajectorySample {
+  NavState truth;
+  ImuIncrement increment;
+  ImuSample sample;
+};
+
+// Streaming generator: memory O(1) in the trajectory length.
+class TrajectoryGenerator {
+ public:
+  // Validates the motion (throws SpecError naming the field) and plans the segments.
+  TrajectoryGenerator(const MotionSpec& motion, double rate_hz);
+  ~TrajectoryGenerator();
+  TrajectoryGenerator(TrajectoryGenerator&&) noexcept;
+  TrajectoryGenerator& operator=(TrajectoryGenerator&&) noexcept;
+
+  const NavEnvironment& environment() const;
+  double rate_hz() const;
+  double dt_s() const;
+  double duration_s() const;
+  // Number of output intervals: floor(duration * rate + 1e-9).
+  int64_t num_steps() const;
+  // Truth and point sample at t = 0.
+  const NavState& initial_state() const;
+  const ImuSample& initial_sample() const;
+  // Times at which the kinematics have a kink (segment boundaries, ramp ends), sorted.
+  const std::vector<double>& breakpoints_s() const;
+  // True while the vehicle is static (speed and angular rate w.r.t. the Earth both zero) at t.
+  bool IsStaticAt(double t_s) const;
+
+  // Advances one output step; false when the trajectory has ended.
+  bool Next(TrajectorySample* out);
+  // Steps produced so far.
+  int64_t step() const;
+
+ private:
+  struct Impl;
+  Impl* impl_;
+};
+
+// Whole trajectory in memory: truth[0..n], samples[0..n] at t_k = k dt, increments[0..n-1] where
+// increments[k] covers (t_k, t_{k+1}].
+struct Trajectory {
+  NavEnvironment environment;
+  double dt_s = 0.0;
+  std::vector<NavState> truth;
+  std::vector<ImuSample> samples;
+  std::vector<ImuIncrement> increments;
+};
+
+Trajectory GenerateTrajectory(const MotionSpec& motion, double rate_hz);
+
+}  // namespace driftlab

@@ -1,0 +1,174 @@
+#include "driftlab/earth.h"
+
+#include <cmath>
+
+namespace driftlab {
+
+double MeridianRadius(double L_b) {
+  const double s = std::sin(L_b);
+  const double d = 1.0 - kWgs84Eccentricity2 * s * s;
+  return kWgs84SemiMajorAxis_m * (1.0 - kWgs84Eccentricity2) / (d * std::sqrt(d));
+}
+
+double TransverseRadius(double L_b) {
+  const double s = std::sin(L_b);
+  return kWgs84SemiMajorAxis_m / std::sqrt(1.0 - kWgs84Eccentricity2 * s * s);
+}
+
+double SomiglianaGravity(double L_b) {
+  // k = b gamma_p / (a gamma_e) - 1, Groves (2.134) / NIMA TR8350.2 (4-1).
+  const double k = kWgs84SemiMinorAxis_m * kWgs84GammaPole_m_per_s2 /
+                        (kWgs84SemiMajorAxis_m * kWgs84GammaEquator_m_per_s2) -
+                    1.0;
+  const double s2 = std::sin(L_b) * std::sin(L_b);
+  return kWgs84GammaEquator_m_per_s2 * (1.0 + k * s2) / std::sqrt(1.0 - kWgs84Eccentricity2 * s2);
+}
+
+Vector3d GravityNed(double L_b, double h_b) {
+  const double a = kWgs84SemiMajorAxis_m;
+  const double f = kWgs84Flattening;
+  const double s2 = std::sin(L_b) * std::sin(L_b);
+  // m = omega_ie^2 a^2 b / mu, the ratio of centrifugal to gravitational acceleration at the
+  // equator (NIMA TR8350.2 table 3.3: 0.00344978650684).
+  const double m = kWgs84EarthRate_rad_per_s * kWgs84EarthRate_rad_per_s * a * a *
+                   kWgs84SemiMinorAxis_m / kWgs84GM_m3_per_s2;
+  const double g0 = SomiglianaGravity(L_b);
+  const double g_D = g0 * (1.0 - 2.0 / a * (1.0 + f * (1.0 - 2.0 * s2) + m) * h_b +
+                           3.0 * h_b * h_b / (a * a));
+  const double g_N = -8.08e-9 * h_b * std::sin(2.0 * L_b);
+  return Vector3d(g_N, 0.0, g_D);
+}
+
+Vector3d EarthRateNed(double L_b) {
+  return Vector3d(kWgs84EarthRate_rad_per_s * std::cos(L_b), 0.0,
+                  -kWgs84EarthRate_rad_per_s * std::sin(L_b));
+}
+
+Vector3d TransportRateNed(double L_b, double h_b, const Vector3d& v_eb_n) {
+  const double R_E = TransverseRadius(L_b) + h_b;
+  const double R_N = MeridianRadius(L_b) + h_b;
+  return Vector3d(v_eb_n.y() / R_E, -v_eb_n.x() / R_N, -v_eb_n.y() * std::tan(L_b) / R_E);
+}
+
+Vector3d LlhToEcef(const Llh& llh) {
+  const double R_E = TransverseRadius(llh.lat_rad);
+  const double cL = std::cos(llh.lat_rad), sL = std::sin(llh.lat_rad);
+  return Vector3d((R_E + llh.h_m) * cL * std::cos(llh.lon_rad),
+                  (R_E + llh.h_m) * cL * std::sin(llh.lon_rad),
+                  ((1.0 - kWgs84Eccentricity2) * R_E + llh.h_m) * sL);
+}
+
+Llh EcefToLlh(const Vector3d& r_eb_e) {
+  const double a = kWgs84SemiMajorAxis_m, b = kWgs84SemiMinorAxis_m, e2 = kWgs84Eccentricity2;
+  const double p = std::hypot(r_eb_e.x(), r_eb_e.y());
+  const double z = r_eb_e.z();
+  Llh llh;
+  llh.lon_rad = std::atan2(r_eb_e.y(), r_eb_e.x());
+  if (p < 1e-9) {  // on the polar axis
+    llh.lat_rad = z >= 0.0 ? M_PI / 2.0 : -M_PI / 2.0;
+    llh.h_m = std::abs(z) - b;
+    return llh;
+  }
+  // Bowring's initial guess (ep2 = second eccentricity squared), then fixed-point iteration
+  // of L = atan((z + e^2 R_E sin L) / p), which converges quadratically from this start.
+  const double ep2 = e2 / (1.0 - e2);
+  const double u = std::atan2(z * a, p * b);
+  double L = std::atan2(z + ep2 * b * std::pow(std::sin(u), 3), p - e2 * a * std::pow(std::cos(u), 3));
+  for (int i = 0; i < 8; ++i) {
+    const double R_E = TransverseRadius(L);
+    const double L_next = std::atan2(z + e2 * R_E * std::sin(L), p);
+    const bool done = std::abs(L_next - L) < 1e-15;
+    L = L_next;
+    if (done) break;
+  }
+  llh.lat_rad = L;
+  const double R_E = TransverseRadius(L);
+  // Height: use the better-conditioned form away from the poles.
+  if (std::abs(std::cos(L)) > 1e-3) {
+    llh.h_m = p / std::cos(L) - R_E;
+  } else {
+    llh.h_m = z / std::sin(L) - (1.0 - e2) * R_E;
+  }
+  return llh;
+}
+
+Matrix3d EcefToNedDcm(double L_b, double lambda_b) {
+  const double sL = std::sin(L_b), cL = std::cos(L_b);
+  const double sl = std::sin(lambda_b), cl = std::cos(lambda_b);
+  Matrix3d C_e_n;
+  C_e_n << -sL * cl, -sL * sl, cL,  //
+      -sl, cl, 0.0,                 //
+      -cL * cl, -cL * sl, -sL;
+  return C_e_n;
+}
+
+Vector3d LlhToNed(const Llh& p, const Llh& ref) {
+  return EcefToNedDcm(ref.lat_rad, ref.lon_rad) * (LlhToEcef(p) - LlhToEcef(ref));
+}
+
+Llh NedToLlh(const Vector3d& r_n, const Llh& ref) {
+  const Matrix3d C_n_e = EcefToNedDcm(ref.lat_rad, ref.lon_rad).transpose();
+  return EcefToLlh(LlhToEcef(ref) + C_n_e * r_n);
+}
+
+NavEnvironment NavEnvironment::Wgs84() { return NavEnvironment(); }
+
+NavEnvironment NavEnvironment::Flat(const Llh& reference, double gravity_m_per_s2) {
+  NavEnvironment env;
+  env.model_ = EarthModel::kFlat;
+  // Radii frozen at the reference point; for the flat frame they only scale metres to the
+  // latitude/longitude bookkeeping and back, so any positive constant gives the same metres.
+  env.flat_R_N_m_ = MeridianRadius(reference.lat_rad) + reference.h_m;
+  env.flat_R_E_m_ = TransverseRadius(reference.lat_rad) + reference.h_m;
+  env.flat_gravity_m_per_s2_ = gravity_m_per_s2;
+  return env;
+}
+
+double NavEnvironment::MeridianRadiusAt(double L_b) const {
+  return model_ == EarthModel::kFlat ? flat_R_N_m_ : MeridianRadius(L_b);
+}
+
+double NavEnvironment::TransverseRadiusAt(double L_b) const {
+  return model_ == EarthModel::kFlat ? flat_R_E_m_ : TransverseRadius(L_b);
+}
+
+Vector3d NavEnvironment::Gravity(double L_b, double h_b) const {
+  if (model_ == EarthModel::kFlat) return Vector3d(0.0, 0.0, flat_gravity_m_per_s2_);
+  return GravityNed(L_b, h_b);
+}
+
+Vector3d NavEnvironment::EarthRate(double L_b) const {
+  if (model_ == EarthModel::kFlat) return Vector3d::Zero();
+  return EarthRateNed(L_b);
+}
+
+Vector3d NavEnvironment::TransportRate(double L_b, double h_b, const Vector3d& v_eb_n) const {
+  if (model_ == EarthModel::kFlat) return Vector3d::Zero();
+  return TransportRateNed(L_b, h_b, v_eb_n);
+}
+
+Vector3d NavEnvironment::LlhRate(double L_b, double h_b, const Vector3d& v_eb_n) const {
+  if (model_ == EarthModel::kFlat) {
+    // Flat frame: h plays no part in the metre scaling and there is no convergence of meridians.
+    return Vector3d(v_eb_n.x() / flat_R_N_m_, v_eb_n.y() / flat_R_E_m_, -v_eb_n.z());
+  }
+  return Vector3d(v_eb_n.x() / (MeridianRadius(L_b) + h_b),
+                  v_eb_n.y() / ((TransverseRadius(L_b) + h_b) * std::cos(L_b)), -v_eb_n.z());
+}
+
+Vector3d NavEnvironment::PositionErrorNed(const Llh& estimate, const Llh& truth) const {
+  const double dL = estimate.lat_rad - truth.lat_rad;
+  double dlambda = estimate.lon_rad - truth.lon_rad;
+  dlambda = std::remainder(dlambda, 2.0 * M_PI);
+  const double dh = estimate.h_m - truth.h_m;
+  if (model_ == EarthModel::kFlat) {
+    return Vector3d(dL * flat_R_N_m_, dlambda * flat_R_E_m_, -dh);
+  }
+  // First-order curvilinear-to-metre scaling, Groves (2.119); exact to ~1e-7 relative for the
+  // position errors of interest (< 100 km).
+  return Vector3d(dL * (MeridianRadius(truth.lat_rad) + truth.h_m),
+                  dlambda * (TransverseRadius(truth.lat_rad) + truth.h_m) * std::cos(truth.lat_rad),
+                  -dh);
+}
+
+}  // namespace driftlab
