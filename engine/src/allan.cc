@@ -1,0 +1,405 @@
+#include "driftlab/allan.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "driftlab/spec_error.h"
+
+namespace driftlab {
+namespace {
+
+// Integrated series x_i = sum_{k<i} (y_k - mean(y)), i = 0..n, in units of rate * sample.
+// Removing the mean first leaves every second difference unchanged (it annihilates a linear
+// phase) and keeps x small, so the second differences lose fewer digits to cancellation. Both
+// sums are Kahan-compensated (Higham, "Accuracy and Stability of Numerical Algorithms", 4.3).
+std::vector<double> IntegratedSeries(std::span<const double> y) {
+  double sum = 0.0, c = 0.0;
+  for (const double v : y) {
+    const double t = sum + (v - c);
+    c = (t - sum) - (v - c);
+    sum = t;
+  }
+  const double mean = sum / static_cast<double>(y.size());
+  std::vector<double> x(y.size() + 1);
+  x[0] = 0.0;
+  sum = 0.0;
+  c = 0.0;
+  for (size_t k = 0; k < y.size(); ++k) {
+    const double v = (y[k] - mean) - c;
+    const double t = sum + v;
+    c = (t - sum) - v;
+    sum = t;
+    x[k + 1] = sum;
+  }
+  return x;
+}
+
+// Sum over i of (x_{i+2m} - 2 x_{i+m} + x_i)^2, i = 0..n_phase-2m-1. Four interleaved partial
+// sums in a fixed order (deterministic, independent of threads).
+double SecondDifferenceSumOfSquares(const std::vector<double>& x, int64_t m) {
+  const int64_t terms = static_cast<int64_t>(x.size()) - 2 * m;
+  const double* p = x.data();
+  double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+  int64_t i = 0;
+  for (; i + 4 <= terms; i += 4) {
+    const double d0 = p[i + 2 * m] - 2.0 * p[i + m] + p[i];
+    const double d1 = p[i + 1 + 2 * m] - 2.0 * p[i + 1 + m] + p[i + 1];
+    const double d2 = p[i + 2 + 2 * m] - 2.0 * p[i + 2 + m] + p[i + 2];
+    const double d3 = p[i + 3 + 2 * m] - 2.0 * p[i + 3 + m] + p[i + 3];
+    s0 += d0 * d0;
+    s1 += d1 * d1;
+    s2 += d2 * d2;
+    s3 += d3 * d3;
+  }
+  for (; i < terms; ++i) {
+    const double d = p[i + 2 * m] - 2.0 * p[i + m] + p[i];
+    s0 += d * d;
+  }
+  return (s0 + s1) + (s2 + s3);
+}
+
+// Lag-1 autocorrelation of z (mean removed).
+double Lag1Autocorrelation(const std::vector<double>& z) {
+  double mean = 0.0;
+  for (const double v : z) mean += v;
+  mean /= static_cast<double>(z.size());
+  double num = 0.0, den = 0.0;
+  for (size_t i = 0; i < z.size(); ++i) {
+    const double a = z[i] - mean;
+    den += a * a;
+    if (i + 1 < z.size()) num += a * (z[i + 1] - mean);
+  }
+  return den > 0.0 ? num / den : 0.0;
+}
+
+// Minimum number of averaged points for the lag-1 autocorrelation identification. Riley & Greenhall
+// (2004) report it works from about 30 points, but the estimate of alpha = -2 r1 / (1 + r1) has a
+// standard error of about 2 / sqrt(n) (var(r1) ~ 1 / n for white noise), so with 30 points it
+// lands on the wrong side of the +-0.5 rounding boundary ~16 % of the time, and the EDF of white
+// FM mistaken for flicker PM is 10x too large at long tau. With 128 points the standard error is
+// 0.18 and a misidentification a 2.8-sigma (0.5 %) event.
+constexpr int64_t kMinPointsForNoiseId = 128;
+
+// Power-law noise identification by the lag-1 autocorrelation of the m-averaged rate series
+// (Riley & Greenhall, "Power law noise identification using the lag 1 autocorrelation", Proc.
+// 18th EFTF 2004; NIST SP 1065 section 5.5). For discrete power-law (fractionally differenced)
+// noise with spectrum ~ f^p the lag-1 autocorrelation is rho = -p / (2 + p), so
+// delta = rho / (1 + rho) = -p / 2. The series is differenced d times (each raises p by 2) until
+// delta < 0.25 (stationary) or d = 2, and then alpha = -2 (delta + d) for rate ("frequency") data.
+// Rounded to the nearest integer in [-2, 2]. Returns false when fewer than kMinPointsForNoiseId
+// averages exist.
+bool IdentifyNoiseType(const std::vector<double>& x, int64_t m, AllanNoiseType* type) {
+  const int64_t n_avg = (static_cast<int64_t>(x.size()) - 1) / m;
+  if (n_avg < kMinPointsForNoiseId) return false;
+  std::vector<double> z(static_cast<size_t>(n_avg));
+  for (int64_t j = 0; j < n_avg; ++j) z[j] = x[(j + 1) * m] - x[j * m];  // m * block mean
+  constexpr int kMaxDifferences = 2;
+  double alpha = 0.0;
+  for (int d = 0;; ++d) {
+    const double rho = Lag1Autocorrelation(z);
+    const double delta = rho / (1.0 + rho);
+    if (delta < 0.25 || d >= kMaxDifferences) {
+      alpha = -2.0 * (delta + d);
+      break;
+    }
+    for (size_t i = 0; i + 1 < z.size(); ++i) z[i] = z[i + 1] - z[i];
+    z.pop_back();
+  }
+  const int alpha_int = static_cast<int>(std::clamp(std::lround(alpha), -2L, 2L));
+  *type = static_cast<AllanNoiseType>(alpha_int);
+  return true;
+}
+
+// Standard normal quantile, Abramowitz & Stegun 26.2.23 (|error| < 4.5e-4); used only as the
+// starting point of the chi-square quantile iteration.
+double NormalQuantileApprox(double p) {
+  const double q = p < 0.5 ? p : 1.0 - p;
+  const double t = std::sqrt(-2.0 * std::log(q));
+  const double z = t - (2.515517 + 0.802853 * t + 0.010328 * t * t) /
+                           (1.0 + 1.432788 * t + 0.189269 * t * t + 0.001308 * t * t * t);
+  return p < 0.5 ? -z : z;
+}
+
+// Regularized lower incomplete gamma function P(a, x), a > 0, x >= 0: the power series
+//   P = e^-x x^a / Gamma(a + 1) sum_k x^k / ((a + 1) ... (a + k))          for x < a + 1,
+// and otherwise 1 - Q with Q from the Legendre continued fraction evaluated by the modified Lentz
+// method (Abramowitz & Stegun 6.5.29 and 6.5.31; Press et al., Numerical Recipes, 3rd ed., 6.2).
+double RegularizedGammaP(double a, double x) {
+  if (x <= 0.0) return 0.0;
+  const double log_prefactor = a * std::log(x) - x - std::lgamma(a);
+  if (x < a + 1.0) {
+    double term = 1.0 / a, sum = term;
+    for (int k = 1; k < 1000; ++k) {
+      term *= x / (a + k);
+      sum += term;
+      if (std::abs(term) < std::abs(sum) * 1e-16) break;
+    }
+    return sum * std::exp(log_prefactor);
+  }
+  constexpr double kTiny = 1e-300;
+  double b = x + 1.0 - a, c = 1.0 / kTiny, d = 1.0 / b, h = d;
+  for (int i = 1; i < 1000; ++i) {
+    const double an = -i * (i - a);
+    b += 2.0;
+    d = an * d + b;
+    if (std::abs(d) < kTiny) d = kTiny;
+    c = b + an / c;
+    if (std::abs(c) < kTiny) c = kTiny;
+    d = 1.0 / d;
+    const double delta = d * c;
+    h *= delta;
+    if (std::abs(delta - 1.0) < 1e-16) break;
+  }
+  return 1.0 - std::exp(log_prefactor) * h;
+}
+
+// Tau grid: m_j = round(2^(j / ppo)), distinct, 1 <= m <= (n - 1) / 2.
+std::vector<int64_t> AveragingFactors(int64_t n, int points_per_octave) {
+  std::vector<int64_t> ms;
+  const int64_t m_max = (n - 1) / 2;
+  for (int j = 0;; ++j) {
+    const auto m =
+        static_cast<int64_t>(std::llround(std::exp2(static_cast<double>(j) / points_per_octave)));
+    if (m > m_max) break;
+    if (ms.empty() || m != ms.back()) ms.push_back(m);
+  }
+  return ms;
+}
+
+}  // namespace
+
+double ChiSquareQuantile(double p, double nu) {
+  if (!(p > 0.0 && p < 1.0)) throw SpecError("chi_square.p", std::to_string(p), "(0, 1)");
+  if (!(nu > 0.0 && std::isfinite(nu)))
+    throw SpecError("chi_square.nu", std::to_string(nu), "> 0, finite");
+  const double a = nu / 2.0;
+  auto cdf = [a](double x) { return RegularizedGammaP(a, x / 2.0); };
+  // Wilson & Hilferty (1931): chi2_p(nu) ~ nu (1 - 2/(9 nu) + z_p sqrt(2/(9 nu)))^3.
+  const double k = 2.0 / (9.0 * nu);
+  double x = nu * std::pow(std::max(1.0 - k + NormalQuantileApprox(p) * std::sqrt(k), 1e-3), 3);
+  // Bracket the root of cdf(x) - p, then safeguarded Newton steps (bisection when a step leaves
+  // the bracket). The density is f(x) = exp((a - 1) ln x - x/2 - a ln 2 - lgamma(a)).
+  double lo = 0.0, hi = std::max(x, 1.0);
+  while (cdf(hi) < p) {
+    lo = hi;
+    hi *= 2.0;
+  }
+  if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
+  for (int iter = 0; iter < 200; ++iter) {
+    const double f = cdf(x) - p;
+    if (f < 0.0) {
+      lo = x;
+    } else {
+      hi = x;
+    }
+    const double density =
+        std::exp((a - 1.0) * std::log(x) - x / 2.0 - a * std::log(2.0) - std::lgamma(a));
+    double next = density > 0.0 ? x - f / density : 0.5 * (lo + hi);
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    if (std::abs(next - x) <= 1e-14 * x || hi - lo <= 1e-15 * hi) return next;
+    x = next;
+  }
+  return x;
+}
+
+double OverlappingAdevEdf(AllanNoiseType noise_type, int64_t n_phase, int64_t m) {
+  // Howe, Allan & Barnes, "Properties of signal sources and measurement methods", Proc. 35th
+  // Annual Symposium on Frequency Control (1981), reprinted as NIST Technical Note 1337 (1990)
+  // table 12-4; N = phase points, m = averaging factor, tau = m tau0.
+  const double N = static_cast<double>(n_phase);
+  const double M = static_cast<double>(m);
+  double edf = 1.0;
+  switch (noise_type) {
+    case AllanNoiseType::kWhitePm:  // (N + 1)(N - 2m) / (2 (N - m))
+      edf = (N + 1.0) * (N - 2.0 * M) / (2.0 * (N - M));
+      break;
+    case AllanNoiseType::kFlickerPm:  // exp(sqrt(ln((N - 1) / 2m) ln((2m + 1)(N - 1) / 4)))
+      edf = std::exp(std::sqrt(std::max(
+          0.0, std::log((N - 1.0) / (2.0 * M)) * std::log((2.0 * M + 1.0) * (N - 1.0) / 4.0))));
+      break;
+    case AllanNoiseType::kWhiteFm:  // (3 (N - 1) / 2m - 2 (N - 2) / N) 4 m^2 / (4 m^2 + 5)
+      edf = (3.0 * (N - 1.0) / (2.0 * M) - 2.0 * (N - 2.0) / N) * 4.0 * M * M / (4.0 * M * M + 5.0);
+      break;
+    case AllanNoiseType::kFlickerFm:  // m = 1: 2 (N - 2) / (2.3 N - 4.9); m >= 2: 5 N^2 / (4m (N +
+                                      // 3m))
+      edf = m == 1 ? 2.0 * (N - 2.0) / (2.3 * N - 4.9) : 5.0 * N * N / (4.0 * M * (N + 3.0 * M));
+      break;
+    case AllanNoiseType::kRandomWalkFm:  // (N - 2)/m ((N - 1)^2 - 3m (N - 1) + 4 m^2) / (N - 3)^2
+      edf = (N - 2.0) / M * ((N - 1.0) * (N - 1.0) - 3.0 * M * (N - 1.0) + 4.0 * M * M) /
+            ((N - 3.0) * (N - 3.0));
+      break;
+    case AllanNoiseType::kAuto:
+      throw SpecError("allan.noise_type", "auto", "a power-law noise type (white PM .. RW FM)");
+  }
+  // At the largest tau (m ~ (N - 2) / 2) all the approximations tend to ~1; keep a floor so that
+  // the chi-square quantile is defined for small N where the formulas can dip below it.
+  return std::max(edf, 1.0);
+}
+
+std::vector<AllanPoint> OverlappingAllanDeviation(std::span<const double> rate_samples,
+                                                  double rate_hz, const AllanOptions& options) {
+  if (!(rate_hz > 0.0 && std::isfinite(rate_hz)))
+    throw SpecError("allan.rate_hz", std::to_string(rate_hz), "> 0, finite");
+  if (rate_samples.size() < 3)
+    throw SpecError("allan.samples", std::to_string(rate_samples.size()) + " samples",
+                    ">= 3 samples");
+  if (options.points_per_octave < 1 || options.points_per_octave > 64)
+    throw SpecError("allan.points_per_octave", std::to_string(options.points_per_octave),
+                    "1 .. 64");
+  if (!(options.confidence > 0.0 && options.confidence < 1.0))
+    throw SpecError("allan.confidence", std::to_string(options.confidence), "(0, 1)");
+  for (size_t k = 0; k < rate_samples.size(); ++k) {
+    if (!std::isfinite(rate_samples[k]))
+      throw SpecError("allan.samples[" + std::to_string(k) + "]", std::to_string(rate_samples[k]),
+                      "finite numbers");
+  }
+
+  const int64_t n = static_cast<int64_t>(rate_samples.size());
+  const double tau0_s = 1.0 / rate_hz;
+  const std::vector<double> x = IntegratedSeries(rate_samples);
+  const std::vector<int64_t> ms = AveragingFactors(n, options.points_per_octave);
+
+  std::vector<AllanPoint> curve(ms.size());
+  std::vector<char> identified(ms.size(), 0);
+  // Each tau is independent and its sum has a fixed order, so the result does not depend on the
+  // thread count or the scheduling.
+  tbb::parallel_for(size_t{0}, ms.size(), [&](size_t j) {
+    const int64_t m = ms[j];
+    const int64_t terms = n + 1 - 2 * m;
+    AllanPoint& point = curve[j];
+    point.m = m;
+    point.tau_s = static_cast<double>(m) * tau0_s;
+    point.n_clusters = terms;
+    // x is in rate * sample units: AVAR = sum / (2 m^2 terms) in rate^2.
+    const double avar = SecondDifferenceSumOfSquares(x, m) /
+                        (2.0 * static_cast<double>(m) * static_cast<double>(m) * terms);
+    point.adev = std::sqrt(avar);
+    if (options.noise_type == AllanNoiseType::kAuto) {
+      identified[j] = IdentifyNoiseType(x, m, &point.noise_type) ? 1 : 0;
+    } else {
+      point.noise_type = options.noise_type;
+    }
+  });
+
+  // Too few averages to identify the noise at the longest taus: carry the type identified at the
+  // longest tau that had enough (white FM if none did).
+  if (options.noise_type == AllanNoiseType::kAuto) {
+    AllanNoiseType last = AllanNoiseType::kWhiteFm;
+    for (size_t j = 0; j < curve.size(); ++j) {
+      if (identified[j]) {
+        last = curve[j].noise_type;
+      } else {
+        curve[j].noise_type = last;
+      }
+    }
+  }
+
+  // Chi-square interval for the variance: edf s^2 / sigma^2 ~ chi2(edf) (NIST SP 1065 section
+  // 5.3, eq. for the chi-square confidence interval), so
+  //   sigma in [s sqrt(edf / chi2_{(1+c)/2}), s sqrt(edf / chi2_{(1-c)/2})].
+  const double p_low = 0.5 * (1.0 - options.confidence);
+  const double p_high = 0.5 * (1.0 + options.confidence);
+  for (AllanPoint& point : curve) {
+    point.edf = OverlappingAdevEdf(point.noise_type, n + 1, point.m);
+    point.adev_low = point.adev * std::sqrt(point.edf / ChiSquareQuantile(p_high, point.edf));
+    point.adev_high = point.adev * std::sqrt(point.edf / ChiSquareQuantile(p_low, point.edf));
+  }
+  return curve;
+}
+
+std::vector<AllanPoint> OverlappingAllanDeviation(std::span<const double> rate_samples,
+                                                  double rate_hz, int points_per_octave) {
+  AllanOptions options;
+  options.points_per_octave = points_per_octave;
+  return OverlappingAllanDeviation(rate_samples, rate_hz, options);
+}
+
+double AllanCurveModel(double tau_s, double N, double B, double K, double Q, double R) {
+  // IEEE Std 952-1997 table C.2; 2 ln 2 / pi = 0.4413 is the flat flicker level (0.664 B)^2.
+  const double avar = 3.0 * Q * Q / (tau_s * tau_s) + N * N / tau_s +
+                      2.0 * std::log(2.0) / M_PI * B * B + K * K * tau_s / 3.0 +
+                      R * R * tau_s * tau_s / 2.0;
+  return std::sqrt(avar);
+}
+
+namespace {
+
+// Fixed-slope fit ln adev = ln c + s ln tau through the points where the term dominates, weighted
+// by edf (var(ln adev) ~ 1 / (2 edf) for a chi-square variance with edf degrees of freedom).
+// A point is used when its local log-log slope is within max(kSlopeTolerance, 2 sigma_slope) of s,
+// sigma_slope being the slope's own standard error from the edf of its neighbours (capped at
+// kMaxSlopeTolerance, half the 1/2 step between terms). Why 0.05: where two terms with slopes
+// 1/2 apart mix, the local slope is s + 0.5 f with f the other term's share of the variance, so
+// |slope - s| <= 0.05 bounds f <= 0.1 and the bias of that point's ADEV to 1/sqrt(0.9) - 1 = 5.4 %.
+constexpr double kSlopeTolerance = 0.05;
+constexpr double kMaxSlopeTolerance = 0.25;
+
+AllanTermFit FitSlope(std::span<const AllanPoint> curve, const std::vector<double>& local_slope,
+                      const std::vector<double>& slope_sigma, double slope, double tau_ref_s) {
+  AllanTermFit fit;
+  double sum_w = 0.0, sum_wy = 0.0;
+  for (size_t i = 0; i < curve.size(); ++i) {
+    const double tolerance =
+        std::min(kMaxSlopeTolerance, std::max(kSlopeTolerance, 2.0 * slope_sigma[i]));
+    if (!(std::abs(local_slope[i] - slope) <= tolerance) || !(curve[i].adev > 0.0)) continue;
+    const double w = curve[i].edf;
+    sum_w += w;
+    sum_wy += w * (std::log(curve[i].adev) - slope * std::log(curve[i].tau_s));
+    if (fit.n_points == 0) fit.tau_min_s = curve[i].tau_s;
+    fit.tau_max_s = curve[i].tau_s;
+    ++fit.n_points;
+  }
+  if (fit.n_points > 0 && sum_w > 0.0) {
+    fit.value = std::exp(sum_wy / sum_w + slope * std::log(tau_ref_s));
+  } else {
+    fit = AllanTermFit();
+  }
+  return fit;
+}
+
+}  // namespace
+
+AllanReadOff ReadOffNoiseTerms(std::span<const AllanPoint> curve) {
+  AllanReadOff out;
+  if (curve.size() < 2) return out;
+  // Local log-log slope: central difference, one-sided at the ends.
+  // Its standard error treats the two neighbours as independent, each with
+  // var(ln adev) = 1 / (2 edf); overlapping estimates are positively correlated, so this errs on
+  // the large side.
+  std::vector<double> slope(curve.size()), slope_sigma(curve.size());
+  for (size_t i = 0; i < curve.size(); ++i) {
+    const size_t a = i == 0 ? 0 : i - 1;
+    const size_t b = i + 1 == curve.size() ? i : i + 1;
+    const double d_ln_tau = std::log(curve[b].tau_s) - std::log(curve[a].tau_s);
+    const bool valid = curve[a].adev > 0.0 && curve[b].adev > 0.0 && d_ln_tau > 0.0 &&
+                       curve[a].edf > 0.0 && curve[b].edf > 0.0;
+    slope[i] = valid ? (std::log(curve[b].adev) - std::log(curve[a].adev)) / d_ln_tau
+                     : std::numeric_limits<double>::quiet_NaN();
+    slope_sigma[i] =
+        valid ? std::sqrt(0.5 / curve[a].edf + 0.5 / curve[b].edf) / d_ln_tau : kMaxSlopeTolerance;
+  }
+  // ADEV = sqrt(3) Q / tau -> Q = ADEV(sqrt(3)); N / sqrt(tau) -> N = ADEV(1);
+  // K sqrt(tau / 3) -> K = ADEV(3); R tau / sqrt(2) -> R = ADEV(sqrt(2)).
+  out.quantization = FitSlope(curve, slope, slope_sigma, -1.0, std::sqrt(3.0));
+  out.white_noise = FitSlope(curve, slope, slope_sigma, -0.5, 1.0);
+  out.random_walk = FitSlope(curve, slope, slope_sigma, 0.5, 3.0);
+  out.rate_ramp = FitSlope(curve, slope, slope_sigma, 1.0, std::sqrt(2.0));
+  // Bias instability: the flat minimum, B = min ADEV / sqrt(2 ln 2 / pi). Only an interior
+  // minimum is a floor; a minimum at either end of the curve means the floor was not reached.
+  size_t i_min = 0;
+  for (size_t i = 1; i < curve.size(); ++i) {
+    if (curve[i].adev < curve[i_min].adev) i_min = i;
+  }
+  if (i_min > 0 && i_min + 1 < curve.size()) {
+    out.bias_instability.value = curve[i_min].adev / std::sqrt(2.0 * std::log(2.0) / M_PI);
+    out.bias_instability.tau_min_s = curve[i_min].tau_s;
+    out.bias_instability.tau_max_s = curve[i_min].tau_s;
+    out.bias_instability.n_points = 1;
+  }
+  return out;
+}
+
+}  // namespace driftlab
