@@ -10,9 +10,8 @@
 // Units below: for gyros "u" = rad/s, for accelerometers "u" = m/s^2.
 #pragma once
 
-#include <string>
-
 #include <Eigen/Core>
+#include <string>
 
 namespace driftlab {
 
@@ -23,10 +22,10 @@ struct GaussMarkovParams {
   double tau_s = 0.0;  // [s] correlation time
 };
 
-// Flicker (1/f) bias instability approximated by a sum of Gauss-Markov processes whose Allan
-// deviation is flat at `bias_instability` (the datasheet figure, i.e. the Allan-deviation floor
-// divided by ... convention: B such that the Allan floor = 0.664 B, IEEE Std 952 Annex C) over
-// [tau_min_s, tau_max_s].
+// Flicker (1/f) bias instability, rate PSD S(f) = B^2 / (2 pi f), approximated by a sum of
+// Gauss-Markov processes (sensors.h, DesignFlickerApproximation) whose Allan deviation is flat at
+// the flicker floor sqrt(2 ln 2 / pi) B = 0.664 B (IEEE Std 952-1997 Annex C, table C.1) over
+// [tau_min_s, tau_max_s] (averaging times). B = `bias_instability` is the datasheet figure.
 struct FlickerParams {
   double bias_instability = 0.0;  // [u] B
   double tau_min_s = 1.0;
@@ -34,20 +33,26 @@ struct FlickerParams {
 };
 
 struct TriadErrorParams {
-  Eigen::Vector3d fixed_bias = Eigen::Vector3d::Zero();       // [u] deterministic, per axis
-  double turn_on_bias_sigma = 0.0;                            // [u] constant per run, per axis
-  GaussMarkovParams bias_gauss_markov;                        // [u], [s]
-  FlickerParams bias_flicker;                                 // [u]
-  double white_noise_density = 0.0;    // [u/sqrt(Hz)] = ARW [rad/sqrt(s)] or VRW [m/s/sqrt(s)]
-  double random_walk = 0.0;            // [u*sqrt(Hz)] = rate random walk [rad/s/sqrt(s)] or
-                                       //   acceleration random walk [m/s^2/sqrt(s)]
+  Eigen::Vector3d fixed_bias = Eigen::Vector3d::Zero();  // [u] deterministic, per axis
+  double turn_on_bias_sigma = 0.0;                       // [u] constant per run, per axis
+  GaussMarkovParams bias_gauss_markov;                   // [u], [s]
+  FlickerParams bias_flicker;                            // [u]
+  double white_noise_density = 0.0;  // [u/sqrt(Hz)] = ARW [rad/sqrt(s)] or VRW [m/s/sqrt(s)]
+  double random_walk = 0.0;          // [u*sqrt(Hz)] = rate random walk [rad/s/sqrt(s)] or
+                                     //   acceleration random walk [m/s^2/sqrt(s)]
   Eigen::Vector3d scale_factor_fixed = Eigen::Vector3d::Zero();  // [-] (ppm * 1e-6)
   double scale_factor_sigma = 0.0;                               // [-] random per run, per axis
+  // Scale-factor asymmetry [-], per axis: (K+ - K-) / K, the difference between the scale
+  // factors for positive and negative inputs relative to the nominal one (IEEE Std 528-2001
+  // "scale factor asymmetry"). The error for an input of sign s is S_ii + s a_i / 2.
+  Eigen::Vector3d scale_factor_asymmetry = Eigen::Vector3d::Zero();
   Eigen::Matrix3d misalignment_fixed = Eigen::Matrix3d::Zero();  // [rad] off-diagonal used only
   double misalignment_sigma_rad = 0.0;                           // [rad] random per run, each
                                                                  //   off-diagonal element
-  double quantization = 0.0;  // [u*s] LSB of the increment output (rad or m/s); 0 = off
-  double range = 0.0;         // [u] saturation (full scale); 0 = unlimited
+  // [u*s] LSB of the increment output (rad or m/s); 0 = off. Point samples use the LSB
+  // quantization * rate_hz [u]. Remainders are carried to the next sample.
+  double quantization = 0.0;
+  double range = 0.0;  // [u] saturation (full scale) of the rate / specific force; 0 = unlimited
 };
 
 struct ImuErrorModel {

@@ -1,0 +1,113 @@
+// Reproducible random streams (DESIGN.md invariant 3): every random number of a job is a pure
+// function of (job seed, run index, sensor, axis, error term, component, sample index), so any
+// run's numbers can be regenerated alone, in any order, on any thread, in any shard.
+//
+// Generator: Philox4x32-10, the counter-based generator of J. K. Salmon, M. A. Moraes, R. O. Dror
+// and D. E. Shaw, "Parallel random numbers: as easy as 1, 2, 3", SC11 (2011), section 5.
+// It is a keyed bijection of a 128-bit counter (4 x 32 bits) under a 64-bit key (2 x 32 bits):
+// distinct counters under one key never give the same output block, so streams cannot overlap.
+//
+// Layout of key and counter (fixed; changing it changes every job's numbers):
+//   key     = (seed low 32 bits, seed high 32 bits)
+//   counter = (block low 32, block high 32, run index, sensor << 24 | axis << 16 | term << 8 |
+//              component)
+// where block = sample index / 4: one Philox call yields 4 x 32 random bits = 4 deviates.
+//
+// Gaussian transform: Box-Muller (G. E. P. Box, M. E. Muller, Ann. Math. Stat. 29 (1958) 610):
+//   z0 = sqrt(-2 ln u1) cos(2 pi u2),  z1 = sqrt(-2 ln u1) sin(2 pi u2)
+// with u1 = (x1 + 1) 2^-32 in (0, 1] and u2 = x2 2^-32 in [0, 1) from two 32-bit words: 32 random
+// bits per deviate, no rejection (branch-free, so it vectorises), and ln, sin, cos are the engine's
+// own polynomials (random.cc) so every build, scalar or SIMD, produces the same bits. sqrt is
+// IEEE-754 correctly rounded and therefore identical everywhere. Consequence of 32-bit uniforms:
+// |z| <= sqrt(-2 ln 2^-32) = 6.66, i.e. the tails beyond 6.66 sigma (probability 2.7e-11) are
+// absent; the distribution is otherwise exact to ~1e-15 relative (polynomial truncation).
+// Vectorisation: deviates are produced in chunks of 32 Philox blocks (SoA); GCC 12 vectorises the
+// Philox loop at baseline x86-64, while the Box-Muller loop is branch-free but still scalar there
+// (sqrt's errno path and uint32 -> double conversion block it); an explicit SIMD pack type, as
+// planned for the lockstep runs, keeps these bits since all operations are IEEE basic ones.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+
+namespace driftlab {
+
+// The Philox4x32 round count recommended by Salmon et al. (10 rounds: "Crush-resistant" with a
+// safety margin; Table 2 of the paper).
+inline constexpr int kPhiloxRounds = 10;
+
+// One Philox4x32-10 block: the 4 x 32-bit output for `counter` under `key`.
+// Known-answer vectors: Random123 kat_vectors (tests/random_test.cc).
+std::array<uint32_t, 4> Philox4x32(const std::array<uint32_t, 4>& counter,
+                                   const std::array<uint32_t, 2>& key);
+
+// Which sensor a stream belongs to (aiding sensors reserve their numbers now so that adding them
+// later does not change the numbers of the inertial sensors).
+enum class SensorId : uint8_t {
+  kGyro = 0,
+  kAccel = 1,
+  kMagnetometer = 2,
+  kBarometer = 3,
+  kGnss = 4,
+  kOdometer = 5,
+  kInitialConditions = 6,  // per-run initial navigation errors
+};
+
+// Which error term a stream drives. `component` (StreamKey) distinguishes several streams of one
+// term, e.g. the Gauss-Markov components of the flicker approximation.
+enum class ErrorTerm : uint8_t {
+  kWhiteNoise = 0,           // per sample
+  kRandomWalk = 1,           // per sample: the walk's step
+  kRandomWalkIntegral = 2,   // per sample: the Brownian-bridge part of the increment integral
+  kGaussMarkov = 3,          // per sample: the process' driving noise
+  kGaussMarkovIntegral = 4,  // per sample: the part of the increment integral independent of it
+  kFlicker = 5,              // per update of flicker component `component`
+  kInitialState = 6,         // stationary initial states (component 0 = GM, 1 + j = flicker j)
+  kTurnOnBias = 7,           // per run, index 0
+  kScaleFactor = 8,          // per run, index 0
+  kMisalignment = 9,         // per run, index 0; axis = row, component = column
+  kQuantizationDither = 10,  // reserved
+  kInitialError = 11,        // per run: initial navigation errors
+};
+
+// Identity of one stream within a run.
+struct StreamKey {
+  SensorId sensor = SensorId::kGyro;
+  uint8_t axis = 0;  // 0, 1, 2 = x, y, z of the sensor triad
+  ErrorTerm term = ErrorTerm::kWhiteNoise;
+  uint8_t component = 0;
+};
+
+// One stream of independent N(0, 1) (or U(0, 1)) deviates indexed by a 64-bit sample index.
+// A small value type (24 bytes): copy it freely; it has no state, so the same index always gives
+// the same number. Thread-safe (const).
+class RandomStream {
+ public:
+  RandomStream() = default;
+  RandomStream(uint64_t seed, uint32_t run_index, StreamKey key);
+
+  // out[i] = deviate number first_index + i of this stream, N(0, 1). No allocation.
+  void FillGaussian(uint64_t first_index, std::span<double> out) const;
+  // out[i] = uniform deviate number first_index + i in (0, 1): (x + 0.5) 2^-32.
+  void FillUniform(uint64_t first_index, std::span<double> out) const;
+  // Single deviates (convenience for per-run constants; use the Fill functions in loops).
+  double Gaussian(uint64_t index) const;
+  double Uniform(uint64_t index) const;
+
+ private:
+  std::array<uint32_t, 2> key_{};
+  uint32_t run_word_ = 0;
+  uint32_t stream_word_ = 0;
+};
+
+// The engine's own elementary functions for the Gaussian transform (exposed for tests).
+// Natural logarithm of x in [2^-1022, 2^1024): exponent/mantissa split, then
+// ln m = 2 atanh(s), s = (m - 1)/(m + 1), Taylor series to s^21 (|s| <= 0.172, truncation < 1e-17).
+double PolyLog(double x);
+// sin(2 pi u) and cos(2 pi u) for u = x 2^-32 in [0, 1): reduced exactly (integer arithmetic) to
+// a quadrant and theta in [-pi/4, pi/4], Taylor series to theta^17 (sin) and theta^16 (cos)
+// (truncation < 1e-19), then rotated by the quadrant.
+void PolySinCosTwoPi(uint32_t x, double* sin_out, double* cos_out);
+
+}  // namespace driftlab

@@ -1,0 +1,418 @@
+// Inertial sensor triad error simulation (sensors.h).
+//
+// Per-run constants (exp, expm1, sqrt of the step's coefficients) use std:: functions at
+// construction only; the hot path (Apply) uses + - * / sqrt floor and the engine's Gaussian
+// streams, so its bits depend only on those constants.
+#include "driftlab/sensors.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "driftlab/spec_error.h"
+
+namespace driftlab {
+namespace {
+
+std::string FormatValue(double v) {
+  char buffer[40];
+  std::snprintf(buffer, sizeof(buffer), "%.17g", v);
+  return buffer;
+}
+
+void RequireFinite(double v, const std::string& field) {
+  if (!std::isfinite(v)) throw SpecError(field, FormatValue(v), "a finite number");
+}
+
+void RequireNonNegative(double v, const std::string& field) {
+  if (!std::isfinite(v) || v < 0.0) throw SpecError(field, FormatValue(v), "finite value >= 0");
+}
+
+void RequirePositive(double v, const std::string& field, const std::string& why) {
+  if (!std::isfinite(v) || v <= 0.0) {
+    throw SpecError(field, FormatValue(v), "finite value > 0" + why);
+  }
+}
+
+void RequireOpenUnit(double v, const std::string& field) {
+  if (!std::isfinite(v) || v <= -1.0 || v >= 1.0) {
+    throw SpecError(field, FormatValue(v), "-1 < value < 1 (dimensionless, e.g. 100 ppm = 1e-4)");
+  }
+}
+
+std::string Index(const std::string& field, int i) { return field + "[" + std::to_string(i) + "]"; }
+
+// x - 2 (1 - e^-x) + (1 - e^-2x) / 2 = sum_{n>=3} (-1)^n (2 - 2^(n-1)) x^n / n!
+//   = x^3/3 - x^4/4 + 7 x^5/60 - ...
+// (the normalised variance of the part of a Gauss-Markov increment integral that is independent of
+// the start value; see the derivation in TriadErrorSimulator's constructor). The closed form
+// cancels x to x^3 for small x, so the series is used for x < 0.1.
+double GaussMarkovIntegralShape(double x) {
+  if (x >= 0.1) return x + 2.0 * std::expm1(-x) - 0.5 * std::expm1(-2.0 * x);
+  double sum = 0.0;
+  double power_over_factorial = x * x / 2.0;  // x^n / n! at n = 2
+  double two_pow = 2.0;                       // 2^(n-1) at n = 2
+  for (int n = 3; n <= 30; ++n) {
+    power_over_factorial *= x / n;
+    two_pow *= 2.0;
+    const double term = ((n % 2 == 0) ? 1.0 : -1.0) * (2.0 - two_pow) * power_over_factorial;
+    sum += term;
+    if (std::fabs(term) < 1e-18 * std::fabs(sum)) break;
+  }
+  return sum;
+}
+
+// g(x) = AVAR / sigma^2 of a Gauss-Markov process at t = x tau:
+//   g(x) = (2x - (3 - 4 e^-x + e^-2x)) / x^2 = sum_{n>=3} (-1)^(n+1) (2^n - 4) x^(n-2) / n!
+double GaussMarkovAllanShape(double x) {
+  if (x >= 0.1) {
+    const double h = -4.0 * std::expm1(-x) + std::expm1(-2.0 * x);  // 3 - 4 e^-x + e^-2x
+    return (2.0 * x - h) / (x * x);
+  }
+  double sum = 0.0;
+  double power_over_factorial = 0.5;  // x^(n-2) / n! at n = 2
+  double two_pow = 4.0;               // 2^n at n = 2
+  for (int n = 3; n <= 30; ++n) {
+    power_over_factorial *= x / n;
+    two_pow *= 2.0;
+    const double term = ((n % 2 == 0) ? -1.0 : 1.0) * (two_pow - 4.0) * power_over_factorial;
+    sum += term;
+    if (std::fabs(term) <= 1e-18 * std::fabs(sum)) break;
+  }
+  return sum;
+}
+
+}  // namespace
+
+void ValidateTriadErrorParams(const TriadErrorParams& p, const std::string& path) {
+  for (int i = 0; i < 3; ++i) RequireFinite(p.fixed_bias[i], Index(path + ".fixed_bias", i));
+  RequireNonNegative(p.turn_on_bias_sigma, path + ".turn_on_bias_sigma");
+
+  RequireNonNegative(p.bias_gauss_markov.sigma, path + ".bias_gauss_markov.sigma");
+  RequireNonNegative(p.bias_gauss_markov.tau_s, path + ".bias_gauss_markov.tau_s");
+  if (p.bias_gauss_markov.sigma > 0.0) {
+    RequirePositive(p.bias_gauss_markov.tau_s, path + ".bias_gauss_markov.tau_s",
+                    " when bias_gauss_markov.sigma > 0");
+  }
+
+  const FlickerParams& f = p.bias_flicker;
+  RequireNonNegative(f.bias_instability, path + ".bias_flicker.bias_instability");
+  RequireNonNegative(f.tau_min_s, path + ".bias_flicker.tau_min_s");
+  RequireNonNegative(f.tau_max_s, path + ".bias_flicker.tau_max_s");
+  if (f.bias_instability > 0.0) {
+    RequirePositive(f.tau_min_s, path + ".bias_flicker.tau_min_s",
+                    " when bias_flicker.bias_instability > 0");
+    if (!(f.tau_max_s > f.tau_min_s) || f.tau_max_s > kMaxFlickerRangeRatio * f.tau_min_s) {
+      throw SpecError(
+          path + ".bias_flicker.tau_max_s", FormatValue(f.tau_max_s),
+          "tau_min_s < tau_max_s <= 1e9 tau_min_s (tau_min_s = " + FormatValue(f.tau_min_s) + ")");
+    }
+  }
+
+  RequireNonNegative(p.white_noise_density, path + ".white_noise_density");
+  RequireNonNegative(p.random_walk, path + ".random_walk");
+  for (int i = 0; i < 3; ++i) {
+    RequireOpenUnit(p.scale_factor_fixed[i], Index(path + ".scale_factor_fixed", i));
+    RequireOpenUnit(p.scale_factor_asymmetry[i], Index(path + ".scale_factor_asymmetry", i));
+  }
+  RequireNonNegative(p.scale_factor_sigma, path + ".scale_factor_sigma");
+  if (p.scale_factor_sigma >= 0.1) {
+    throw SpecError(path + ".scale_factor_sigma", FormatValue(p.scale_factor_sigma),
+                    "0 <= value < 0.1 (10 %; dimensionless)");
+  }
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      const std::string field = Index(Index(path + ".misalignment_fixed", r), c);
+      const double m = p.misalignment_fixed(r, c);
+      if (r == c) {
+        if (m != 0.0) {
+          throw SpecError(field, FormatValue(m),
+                          "0 (diagonal: use scale_factor_fixed for scale-factor errors)");
+        }
+      } else if (!std::isfinite(m) || std::fabs(m) >= 0.5) {
+        throw SpecError(field, FormatValue(m), "|value| < 0.5 rad (small misalignment)");
+      }
+    }
+  }
+  RequireNonNegative(p.misalignment_sigma_rad, path + ".misalignment_sigma_rad");
+  if (p.misalignment_sigma_rad >= 0.1) {
+    throw SpecError(path + ".misalignment_sigma_rad", FormatValue(p.misalignment_sigma_rad),
+                    "0 <= value < 0.1 rad");
+  }
+  RequireNonNegative(p.quantization, path + ".quantization");
+  RequireNonNegative(p.range, path + ".range");
+}
+
+void ValidateImuErrorModel(const ImuErrorModel& model, const std::string& path) {
+  ValidateTriadErrorParams(model.gyro, path + ".gyro");
+  ValidateTriadErrorParams(model.accel, path + ".accel");
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) {
+      RequireFinite(model.gyro_g_sensitivity(r, c),
+                    Index(Index(path + ".gyro_g_sensitivity", r), c));
+    }
+  }
+}
+
+double GaussMarkovAllanVariance(double sigma, double tau_s, double tau_avg_s) {
+  return sigma * sigma * GaussMarkovAllanShape(tau_avg_s / tau_s);
+}
+
+std::vector<GaussMarkovComponent> DesignFlickerApproximation(const FlickerParams& params) {
+  std::vector<GaussMarkovComponent> components;
+  if (!(params.bias_instability > 0.0)) return components;
+  const double log_lo = std::log(params.tau_min_s / 4.0);
+  const double log_hi = std::log(2.0 * params.tau_max_s);
+  const double max_log_ratio = 0.5 * std::log(10.0);  // two components per decade
+  const int n = static_cast<int>(std::ceil((log_hi - log_lo) / max_log_ratio - 1e-9)) + 1;
+  const double log_ratio = (log_hi - log_lo) / (n - 1);
+  const double variance =
+      params.bias_instability * params.bias_instability * log_ratio / std::numbers::pi;
+  const double end_variance = variance * (1.0 + 1.0 / log_ratio);
+  components.resize(static_cast<size_t>(n));
+  for (int j = 0; j < n; ++j) {
+    const bool end = (j == 0 || j == n - 1);
+    components[j].sigma = std::sqrt(end ? end_variance : variance);
+    components[j].tau_s = std::exp(log_lo + j * log_ratio);
+  }
+  return components;
+}
+
+double SumOfGaussMarkovAllanDeviation(const std::vector<GaussMarkovComponent>& components,
+                                      double tau_avg_s) {
+  double avar = 0.0;
+  for (const GaussMarkovComponent& c : components) {
+    avar += GaussMarkovAllanVariance(c.sigma, c.tau_s, tau_avg_s);
+  }
+  return std::sqrt(avar);
+}
+
+void TriadErrorSimulator::Channel::Refill(uint64_t index) {
+  base = index & ~static_cast<uint64_t>(kDeviateBlock - 1);
+  stream.FillGaussian(base, std::span<double>(buffer));
+}
+
+TriadErrorSimulator::TriadErrorSimulator(const TriadErrorParams& params, SensorId sensor,
+                                         uint64_t seed, uint32_t run_index, double rate_hz,
+                                         const std::string& path) {
+  ValidateTriadErrorParams(params, path);
+  if (!std::isfinite(rate_hz) || rate_hz <= 0.0) {
+    throw SpecError("rate_hz", FormatValue(rate_hz), "finite value > 0 [Hz]");
+  }
+  dt_s_ = 1.0 / rate_hz;
+  const double dt = dt_s_;
+  auto stream = [&](ErrorTerm term, int axis, int component) {
+    return RandomStream(
+        seed, run_index,
+        StreamKey{sensor, static_cast<uint8_t>(axis), term, static_cast<uint8_t>(component)});
+  };
+  auto add_channels = [&](ErrorTerm term, int count_per_axis) {
+    const int first = static_cast<int>(channels_.size());
+    for (int axis = 0; axis < 3; ++axis) {
+      for (int component = 0; component < count_per_axis; ++component) {
+        channels_.emplace_back();
+        channels_.back().stream = stream(term, axis, component);
+      }
+    }
+    return first;
+  };
+
+  // Per-run constants: I + S + M and the constant bias.
+  for (int i = 0; i < 3; ++i) {
+    double s = params.scale_factor_fixed[i];
+    if (params.scale_factor_sigma > 0.0) {
+      s += params.scale_factor_sigma * stream(ErrorTerm::kScaleFactor, i, 0).Gaussian(0);
+    }
+    scale_misalignment_(i, i) = 1.0 + s;
+    for (int c = 0; c < 3; ++c) {
+      if (c == i) continue;
+      double m = params.misalignment_fixed(i, c);
+      if (params.misalignment_sigma_rad > 0.0) {
+        m += params.misalignment_sigma_rad * stream(ErrorTerm::kMisalignment, i, c).Gaussian(0);
+      }
+      scale_misalignment_(i, c) = m;
+    }
+    double b = params.fixed_bias[i];
+    if (params.turn_on_bias_sigma > 0.0) {
+      b += params.turn_on_bias_sigma * stream(ErrorTerm::kTurnOnBias, i, 0).Gaussian(0);
+    }
+    constant_bias_[i] = b;
+  }
+  half_asymmetry_ = 0.5 * params.scale_factor_asymmetry;
+  has_asymmetry_ = !params.scale_factor_asymmetry.isZero(0.0);
+
+  if (params.white_noise_density > 0.0) {
+    white_increment_ = params.white_noise_density * std::sqrt(dt);
+    white_sample_ = params.white_noise_density / std::sqrt(dt);
+    white_ch_ = add_channels(ErrorTerm::kWhiteNoise, 1);
+  }
+
+  if (params.bias_gauss_markov.sigma > 0.0) {
+    // Ornstein-Uhlenbeck process b' = -b / T + q w(t), q^2 = 2 sigma^2 / T, over one step h = dt,
+    // x = h / T, a = e^-x. Given b_k (Gardiner, "Stochastic Methods", 4th ed., section 3.8.4):
+    //   b_{k+1} = a b_k + eta,          eta = q int_0^h e^{-(h-u)/T} dW(u)
+    //   I_k = int b = T (1 - a) b_k + eps,  eps = q T int_0^h (1 - e^{-(h-u)/T}) dW(u)
+    // Ito isometry: Var eta = sigma^2 (1 - a^2); Cov(eps, eta) = sigma^2 T (1 - a)^2;
+    //   Var eps = 2 sigma^2 T^2 [x - 2 (1 - a) + (1 - a^2) / 2].
+    // Hence eta = drive w1, eps = c w1 + d w2 with drive = sigma sqrt(1 - a^2),
+    // c = Cov / drive, d = sqrt(Var eps - c^2): exact in distribution for any dt / T.
+    const double sigma = params.bias_gauss_markov.sigma;
+    const double T = params.bias_gauss_markov.tau_s;
+    const double x = dt / T;
+    const double one_minus_a = -std::expm1(-x);
+    const double one_minus_a2 = -std::expm1(-2.0 * x);
+    gm_a_ = std::exp(-x);
+    gm_drive_ = sigma * std::sqrt(one_minus_a2);
+    gm_mean_gain_ = T * one_minus_a;
+    gm_c_ = sigma * sigma * T * one_minus_a * one_minus_a / gm_drive_;
+    const double var_eps = 2.0 * sigma * sigma * T * T * GaussMarkovIntegralShape(x);
+    gm_d_ = std::sqrt(std::max(0.0, var_eps - gm_c_ * gm_c_));
+    gm_ch_ = add_channels(ErrorTerm::kGaussMarkov, 1);
+    gm_int_ch_ = add_channels(ErrorTerm::kGaussMarkovIntegral, 1);
+    for (int i = 0; i < 3; ++i) {
+      gm_state_[i] = sigma * stream(ErrorTerm::kInitialState, i, 0).Gaussian(0);
+    }
+  }
+
+  if (params.random_walk > 0.0) {
+    // b_{k+1} = b_k + K W(h); I_k = b_k h + K int_0^h (h - u) dW(u). Given the step, the integral
+    // is b_k h + (h/2) (b_{k+1} - b_k) + a Brownian-bridge term of variance K^2 h^3 / 12
+    // (Var int (h-u) dW = h^3/3, Cov with W(h) = h^2/2: h^3/3 - (h^2/2)^2 / h = h^3/12).
+    rw_step_ = params.random_walk * std::sqrt(dt);
+    rw_bridge_ = params.random_walk * dt * std::sqrt(dt / 12.0);
+    rw_ch_ = add_channels(ErrorTerm::kRandomWalk, 1);
+    rw_int_ch_ = add_channels(ErrorTerm::kRandomWalkIntegral, 1);
+  }
+
+  flicker_ = DesignFlickerApproximation(params.bias_flicker);
+  n_flicker_ = static_cast<int>(flicker_.size());
+  if (n_flicker_ > 0) {
+    // Component j is advanced exactly every h_j = 2^m dt, the largest such h_j <= tau_j / 32
+    // (m = 0 when tau_j < 32 dt), and held between updates. Holding changes the component's
+    // Allan variance by < 0.1 % at t >= tau_j and less at longer t (zero-order hold of the exact
+    // AR(1) sequence; checked numerically at h = tau / 32), while slow components then cost a
+    // deviate only every 2^m samples.
+    for (int j = 0; j < n_flicker_; ++j) {
+      const double T = flicker_[j].tau_s;
+      int m = 0;
+      while (m < 40 && std::ldexp(dt, m + 1) <= T / 32.0) ++m;
+      const double h = std::ldexp(dt, m);
+      flicker_period_log2_[j] = m;
+      flicker_a_[j] = std::exp(-h / T);
+      flicker_drive_[j] = flicker_[j].sigma * std::sqrt(-std::expm1(-2.0 * h / T));
+      for (int i = 0; i < 3; ++i) {
+        flicker_state_[i][j] =
+            flicker_[j].sigma * stream(ErrorTerm::kInitialState, i, 1 + j).Gaussian(0);
+      }
+    }
+    flicker_ch_ = add_channels(ErrorTerm::kFlicker, n_flicker_);
+  }
+
+  range_ = params.range;
+  quantization_ = params.quantization;
+}
+
+template <bool kIncrement>
+Eigen::Vector3d TriadErrorSimulator::Apply(const Eigen::Vector3d& ideal,
+                                           const Eigen::Vector3d& additive) {
+  const double dt = dt_s_;
+  const double weight = kIncrement ? dt : 1.0;  // constant rate -> increment or sample
+  const uint64_t k = static_cast<uint64_t>(step_);
+  Eigen::Vector3d y = scale_misalignment_ * ideal + additive;
+  if (has_asymmetry_) y += half_asymmetry_.cwiseProduct(ideal.cwiseAbs());  // sign(x) a/2 x
+  for (int i = 0; i < 3; ++i) {
+    double e = constant_bias_[i] * weight;
+    if (white_ch_ >= 0) {
+      e += (kIncrement ? white_increment_ : white_sample_) * channels_[white_ch_ + i].At(k);
+    }
+    if (gm_ch_ >= 0) {
+      const double w1 = channels_[gm_ch_ + i].At(k);
+      double& b = gm_state_[i];
+      if constexpr (kIncrement) {
+        e += gm_mean_gain_ * b + gm_c_ * w1 + gm_d_ * channels_[gm_int_ch_ + i].At(k);
+      } else {
+        e += b;
+      }
+      b = gm_a_ * b + gm_drive_ * w1;
+    }
+    if (rw_ch_ >= 0) {
+      const double step = rw_step_ * channels_[rw_ch_ + i].At(k);
+      double& b = rw_state_[i];
+      if constexpr (kIncrement) {
+        e += b * dt + 0.5 * dt * step + rw_bridge_ * channels_[rw_int_ch_ + i].At(k);
+      } else {
+        e += b;
+      }
+      b += step;
+    }
+    if (n_flicker_ > 0) {
+      double sum = 0.0;
+      Channel* ch = &channels_[flicker_ch_ + i * n_flicker_];
+      std::array<double, kMaxFlickerComponents>& x = flicker_state_[i];
+      for (int j = 0; j < n_flicker_; ++j) {
+        const int m = flicker_period_log2_[j];
+        const uint64_t mask = (uint64_t{1} << m) - 1;
+        if (k != 0 && (k & mask) == 0) {
+          x[j] = flicker_a_[j] * x[j] + flicker_drive_[j] * ch[j].At((k >> m) - 1);
+        }
+        sum += x[j];
+      }
+      e += sum * weight;
+    }
+    double v = y[i] + e;
+    if (range_ > 0.0) v = std::clamp(v, -range_ * weight, range_ * weight);
+    if (quantization_ > 0.0) {
+      const double lsb = kIncrement ? quantization_ : quantization_ / dt;
+      const double carried = v + remainder_[i];
+      const double out = lsb * std::floor(carried / lsb + 0.5);
+      remainder_[i] = carried - out;
+      v = out;
+    }
+    y[i] = v;
+  }
+  ++step_;
+  return y;
+}
+
+Eigen::Vector3d TriadErrorSimulator::ApplyIncrement(const Eigen::Vector3d& ideal_increment,
+                                                    const Eigen::Vector3d& additive_increment) {
+  return Apply<true>(ideal_increment, additive_increment);
+}
+
+Eigen::Vector3d TriadErrorSimulator::ApplySample(const Eigen::Vector3d& ideal,
+                                                 const Eigen::Vector3d& additive) {
+  return Apply<false>(ideal, additive);
+}
+
+namespace {
+const ImuErrorModel& Validated(const ImuErrorModel& model) {
+  ValidateImuErrorModel(model, "sensor");
+  return model;
+}
+}  // namespace
+
+ImuErrorSimulator::ImuErrorSimulator(const ImuErrorModel& model, uint64_t seed, uint32_t run_index,
+                                     double rate_hz)
+    : gyro_g_sensitivity_(Validated(model).gyro_g_sensitivity),
+      has_g_sensitivity_(!model.gyro_g_sensitivity.isZero(0.0)),
+      gyro_(model.gyro, SensorId::kGyro, seed, run_index, rate_hz, "sensor.gyro"),
+      accel_(model.accel, SensorId::kAccel, seed, run_index, rate_hz, "sensor.accel") {}
+
+void ImuErrorSimulator::Apply(const ImuIncrement& ideal, ImuIncrement* measured) {
+  const Eigen::Vector3d g_term = has_g_sensitivity_
+                                     ? Eigen::Vector3d(gyro_g_sensitivity_ * ideal.delta_v_ib_b)
+                                     : Eigen::Vector3d::Zero();
+  measured->delta_theta_ib_b = gyro_.ApplyIncrement(ideal.delta_theta_ib_b, g_term);
+  measured->delta_v_ib_b = accel_.ApplyIncrement(ideal.delta_v_ib_b, Eigen::Vector3d::Zero());
+}
+
+void ImuErrorSimulator::Apply(const ImuSample& ideal, ImuSample* measured) {
+  const Eigen::Vector3d g_term = has_g_sensitivity_
+                                     ? Eigen::Vector3d(gyro_g_sensitivity_ * ideal.f_ib_b)
+                                     : Eigen::Vector3d::Zero();
+  measured->omega_ib_b = gyro_.ApplySample(ideal.omega_ib_b, g_term);
+  measured->f_ib_b = accel_.ApplySample(ideal.f_ib_b, Eigen::Vector3d::Zero());
+}
+
+}  // namespace driftlab

@@ -1,0 +1,214 @@
+// Tests of the counter-based random streams (random.h): Philox known answers, the engine's own
+// ln / sin / cos, the N(0, 1) distribution of the deviates, and independence of streams.
+#include "driftlab/random.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+namespace driftlab {
+namespace {
+
+// Two-sided normal quantile for a false-alarm probability of 6.3e-5 per check: with the ~30
+// statistical checks in this file the chance that any fails for a correct generator is < 0.2 %.
+constexpr double kZ = 4.0;
+
+TEST(PhiloxTest, MatchesRandom123KnownAnswerVectors) {
+  // Random123 1.09 kat_vectors, "philox4x32 10": counter[4] key[2] -> output[4].
+  EXPECT_EQ(Philox4x32({0, 0, 0, 0}, {0, 0}),
+            (std::array<uint32_t, 4>{0x6627e8d5u, 0xe169c58du, 0xbc57ac4cu, 0x9b00dbd8u}));
+  EXPECT_EQ(
+      Philox4x32({0xffffffffu, 0xffffffffu, 0xffffffffu, 0xffffffffu}, {0xffffffffu, 0xffffffffu}),
+      (std::array<uint32_t, 4>{0x408f276du, 0x41c83b0eu, 0xa20bc7c6u, 0x6d5451fdu}));
+  EXPECT_EQ(
+      Philox4x32({0x243f6a88u, 0x85a308d3u, 0x13198a2eu, 0x03707344u}, {0xa4093822u, 0x299f31d0u}),
+      (std::array<uint32_t, 4>{0xd16cfe09u, 0x94fdccebu, 0x5001e420u, 0x24126ea1u}));
+}
+
+TEST(PolynomialMathTest, LogMatchesLibmWithinTwoUlp) {
+  // Series truncation < 1e-18 relative; rounding of ~25 operations near 1 ulp. |ln x| >= 2^-33
+  // for the 32-bit uniforms used; compare relatively (2 ulp = 4.4e-16) away from x = 1 and
+  // absolutely (ln x ~ x - 1 there) within 1e-16 * |x - 1| + 2 ulp.
+  for (uint64_t i = 1; i <= (uint64_t{1} << 32); i += 65537) {
+    const double x = static_cast<double>(i) / 4294967296.0;
+    const long double expected = std::log(static_cast<long double>(x));
+    const double got = PolyLog(x);
+    EXPECT_NEAR(got, static_cast<double>(expected),
+                4.5e-16 * std::fabs(static_cast<double>(expected)) + 1e-300)
+        << "x = " << x;
+  }
+  EXPECT_EQ(PolyLog(1.0), 0.0);
+  EXPECT_NEAR(PolyLog(1e-300), std::log(1e-300), 1e-15 * 690.8);
+  EXPECT_NEAR(PolyLog(3.0e10), std::log(3.0e10), 4.5e-16 * 24.1);
+}
+
+TEST(PolynomialMathTest, SinCosOfTwoPiUMatchLongDoubleWithinFewUlp) {
+  // theta = r pi/2 rounds to 0.5 ulp (<= 5.6e-17) and Horner sums add a few 1e-17: 3e-16
+  // absolute (1.4 ulp of 1) bounds the error for |sin|, |cos| <= 1.
+  const long double two_pi = 2.0L * std::numbers::pi_v<long double>;
+  double max_error = 0.0;
+  for (uint64_t i = 0; i < (uint64_t{1} << 32); i += 40009) {  // includes the top quadrant
+    const double u = static_cast<double>(i) / 4294967296.0;
+    double s = 0.0, c = 0.0;
+    PolySinCosTwoPi(static_cast<uint32_t>(i), &s, &c);
+    const long double angle = two_pi * static_cast<long double>(u);
+    max_error = std::max(max_error, std::fabs(s - static_cast<double>(std::sin(angle))));
+    max_error = std::max(max_error, std::fabs(c - static_cast<double>(std::cos(angle))));
+  }
+  EXPECT_LT(max_error, 3e-16);
+  double s = 0.0, c = 0.0;
+  PolySinCosTwoPi(0x40000000u, &s, &c);  // u = 1/4
+  EXPECT_EQ(s, 1.0);
+  EXPECT_EQ(c, 0.0);
+  PolySinCosTwoPi(0xa0000000u, &s, &c);  // u = 5/8: sin = cos = -sqrt(1/2)
+  EXPECT_NEAR(s, -std::numbers::sqrt2 / 2, 2e-16);
+  EXPECT_NEAR(c, -std::numbers::sqrt2 / 2, 2e-16);
+}
+
+std::vector<double> Draw(const RandomStream& stream, uint64_t first, size_t n) {
+  std::vector<double> z(n);
+  stream.FillGaussian(first, z);
+  return z;
+}
+
+TEST(GaussianTest, MomentsMatchStandardNormal) {
+  // n = 4e6: standard errors of mean, variance, skewness, excess kurtosis are sqrt(1/n),
+  // sqrt(2/n), sqrt(6/n), sqrt(24/n) (normal theory); each is checked at kZ standard errors.
+  const size_t n = 4'000'000;
+  const std::vector<double> z =
+      Draw(RandomStream(2024, 7, {SensorId::kGyro, 1, ErrorTerm::kWhiteNoise, 0}), 0, n);
+  long double m1 = 0, m2 = 0, m3 = 0, m4 = 0;
+  for (double v : z) {
+    const long double v2 = static_cast<long double>(v) * v;
+    m1 += v;
+    m2 += v2;
+    m3 += v2 * v;
+    m4 += v2 * v2;
+  }
+  const double nd = static_cast<double>(n);
+  const double mean = static_cast<double>(m1 / nd);
+  const double var = static_cast<double>(m2 / nd) - mean * mean;
+  const double skew = static_cast<double>(m3 / nd) / std::pow(var, 1.5);
+  const double kurt = static_cast<double>(m4 / nd) / (var * var) - 3.0;
+  EXPECT_NEAR(mean, 0.0, kZ * std::sqrt(1.0 / nd));
+  EXPECT_NEAR(var, 1.0, kZ * std::sqrt(2.0 / nd));
+  EXPECT_NEAR(skew, 0.0, kZ * std::sqrt(6.0 / nd));
+  EXPECT_NEAR(kurt, 0.0, kZ * std::sqrt(24.0 / nd));
+}
+
+TEST(GaussianTest, KolmogorovSmirnovAgainstStandardNormal) {
+  // Asymptotic Kolmogorov critical value sqrt(-ln(alpha/2) / 2) / sqrt(n) = 1.949 / sqrt(n) at
+  // alpha = 1e-3 (n = 1e6: 1.95e-3).
+  const size_t n = 1'000'000;
+  std::vector<double> z =
+      Draw(RandomStream(99, 0, {SensorId::kAccel, 2, ErrorTerm::kRandomWalk, 0}), 12345, n);
+  std::sort(z.begin(), z.end());
+  double d = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    const double cdf = 0.5 * std::erfc(-z[i] / std::numbers::sqrt2);
+    d = std::max({d, cdf - static_cast<double>(i) / n, static_cast<double>(i + 1) / n - cdf});
+  }
+  EXPECT_LT(d, 1.949 / std::sqrt(static_cast<double>(n)));
+}
+
+TEST(GaussianTest, TailProbabilitiesMatchStandardNormal) {
+  // Counts beyond |z| > 3 and > 4 are binomial(n, p) with p = erfc(3/sqrt2) = 2.700e-3 and
+  // erfc(4/sqrt2) = 6.334e-5; checked at kZ binomial standard deviations. Exercises the log in
+  // Box-Muller where u1 is small. Also |z| <= 6.67, the bound set by 32-bit uniforms.
+  const size_t n = 4'000'000;
+  const std::vector<double> z =
+      Draw(RandomStream(5, 3, {SensorId::kGyro, 0, ErrorTerm::kGaussMarkov, 0}), 0, n);
+  for (double threshold : {3.0, 4.0}) {
+    const double p = std::erfc(threshold / std::numbers::sqrt2);
+    const double count = static_cast<double>(
+        std::count_if(z.begin(), z.end(), [&](double v) { return std::fabs(v) > threshold; }));
+    const double nd = static_cast<double>(n);
+    EXPECT_NEAR(count, nd * p, kZ * std::sqrt(nd * p * (1 - p))) << "threshold " << threshold;
+  }
+  for (double v : z) ASSERT_LE(std::fabs(v), 6.67);
+}
+
+TEST(RandomStreamTest, BlockFillIsIndependentOfSplitAndOrder) {
+  // Deviate i of a stream must not depend on how it is requested (DESIGN.md invariant 3).
+  const RandomStream stream(42, 17, {SensorId::kGyro, 2, ErrorTerm::kFlicker, 5});
+  const std::vector<double> whole = Draw(stream, 1000, 1000);
+  for (uint64_t first : {1000u, 1001u, 1003u, 1128u, 1999u}) {
+    for (size_t n : {1u, 3u, 4u, 5u, 127u, 129u}) {
+      if (first + n > 2000) continue;
+      const std::vector<double> part = Draw(stream, first, n);
+      for (size_t i = 0; i < n; ++i) ASSERT_EQ(part[i], whole[first - 1000 + i]);
+    }
+  }
+  for (uint64_t i = 1999; i >= 1000; --i) ASSERT_EQ(stream.Gaussian(i), whole[i - 1000]);
+  // Far indices (block counter above 2^32) work and are reproducible.
+  const uint64_t far = (uint64_t{1} << 40) + 3;
+  EXPECT_EQ(Draw(stream, far, 8)[5], stream.Gaussian(far + 5));
+}
+
+double Correlation(const std::vector<double>& a, const std::vector<double>& b) {
+  long double sab = 0, saa = 0, sbb = 0, sa = 0, sb = 0;
+  const size_t n = a.size();
+  for (size_t i = 0; i < n; ++i) {
+    sa += a[i];
+    sb += b[i];
+    sab += static_cast<long double>(a[i]) * b[i];
+    saa += static_cast<long double>(a[i]) * a[i];
+    sbb += static_cast<long double>(b[i]) * b[i];
+  }
+  const long double cov = sab / n - (sa / n) * (sb / n);
+  return static_cast<double>(
+      cov / std::sqrt((saa / n - (sa / n) * (sa / n)) * (sbb / n - (sb / n) * (sb / n))));
+}
+
+TEST(RandomStreamTest, DifferentKeysGiveUncorrelatedStreams) {
+  // Sample correlation of independent streams: sd 1/sqrt(n); bound kZ / sqrt(n) per pair.
+  const size_t n = 200'000;
+  const StreamKey base{SensorId::kGyro, 0, ErrorTerm::kWhiteNoise, 0};
+  const std::vector<double> a = Draw(RandomStream(1, 0, base), 0, n);
+  std::vector<RandomStream> others = {
+      RandomStream(2, 0, base),                                              // seed
+      RandomStream(uint64_t{1} << 32 | 1, 0, base),                          // seed high word
+      RandomStream(1, 1, base),                                              // run
+      RandomStream(1, 0, {SensorId::kAccel, 0, ErrorTerm::kWhiteNoise, 0}),  // sensor
+      RandomStream(1, 0, {SensorId::kGyro, 1, ErrorTerm::kWhiteNoise, 0}),   // axis
+      RandomStream(1, 0, {SensorId::kGyro, 0, ErrorTerm::kRandomWalk, 0}),   // term
+      RandomStream(1, 0, {SensorId::kGyro, 0, ErrorTerm::kWhiteNoise, 1}),   // component
+  };
+  const double bound = kZ / std::sqrt(static_cast<double>(n));
+  for (size_t s = 0; s < others.size(); ++s) {
+    EXPECT_LT(std::fabs(Correlation(a, Draw(others[s], 0, n))), bound) << "pair " << s;
+  }
+  // Within one stream: lags 1 (same Box-Muller pair), 2, 4 (next block) are uncorrelated.
+  for (size_t lag : {1u, 2u, 4u}) {
+    std::vector<double> x(a.begin(), a.end() - lag), y(a.begin() + lag, a.end());
+    EXPECT_LT(std::fabs(Correlation(x, y)), bound) << "lag " << lag;
+  }
+  // The pair (z0, z1) of one Box-Muller draw: z0^2 and z1^2 are independent (sd of the
+  // correlation estimate is again 1/sqrt(n') for n' pairs).
+  std::vector<double> q0, q1;
+  for (size_t i = 0; i + 1 < n; i += 2) {
+    q0.push_back(a[i] * a[i]);
+    q1.push_back(a[i + 1] * a[i + 1]);
+  }
+  EXPECT_LT(std::fabs(Correlation(q0, q1)), kZ / std::sqrt(static_cast<double>(q0.size())));
+}
+
+TEST(RandomStreamTest, UniformDeviatesAreInOpenUnitIntervalWithMeanOneHalf) {
+  // Mean of U(0,1): sd sqrt(1/12 / n).
+  const size_t n = 1'000'000;
+  std::vector<double> u(n);
+  RandomStream(8, 8, {SensorId::kGnss, 0, ErrorTerm::kWhiteNoise, 0}).FillUniform(3, u);
+  long double sum = 0;
+  for (double v : u) {
+    ASSERT_GT(v, 0.0);
+    ASSERT_LT(v, 1.0);
+    sum += v;
+  }
+  EXPECT_NEAR(static_cast<double>(sum / n), 0.5, kZ * std::sqrt(1.0 / 12.0 / n));
+}
+
+}  // namespace
+}  // namespace driftlab
