@@ -6,8 +6,8 @@
 //   omega_ib_b = omega_nb_b + C_n_b (omega_ie_n + omega_en_n)                   Groves (5.40)
 //   f_ib_b     = C_n_b (dv_eb_n/dt - g_b_n + (omega_en_n + 2 omega_ie_n) x v_eb_n)   Groves (5.54)
 // with omega_nb_b from the Euler-angle rates. Position (L, lambda, h) is integrated from the
-// velocity with Groves (2.111). Ideal IMU increments are the integrals of omega_ib_b and f_ib_b over
-// each output interval, computed with Gauss-Legendre quadrature on internal sub-steps that are
+// velocity with Groves (2.111). Ideal IMU increments are the integrals of omega_ib_b and f_ib_b
+// over each output interval, computed with Gauss-Legendre quadrature on internal sub-steps that are
 // split at every breakpoint of the kinematics, so they are exact to rounding for the smooth pieces
 // (and therefore contain the coning and sculling a real integrating IMU sees).
 #pragma once
@@ -27,12 +27,17 @@ namespace driftlab {
 // ---- Motion definition -------------------------------------------------------------------------
 
 struct InitialState {
-  Llh llh;                               // [rad, rad, m]
-  Vector3d v_eb_n = Vector3d::Zero();    // [m/s] NED
-  EulerAngles attitude;                  // [rad]
+  Llh llh;                             // [rad, rad, m]
+  Vector3d v_eb_n = Vector3d::Zero();  // [m/s] NED
+  EulerAngles attitude;                // [rad]
 };
 
-// How the vehicle's attitude follows its velocity in the parametric segments.
+// How the vehicle's attitude follows its velocity in the parametric segments. The parametric model
+// is v_eb_n = [V cos chi, V sin chi, v_D] with ground speed V, track angle chi (initially
+// atan2(v_E, v_N), or the yaw when V = 0) and down velocity v_D; the yaw follows the track
+// (yaw - chi constant), the pitch and roll are held unless the options below say otherwise. The
+// offsets (yaw - chi, pitch - flight-path angle, roll - bank) are fixed at each segment's start, so
+// the attitude is always continuous.
 struct VehicleOptions {
   // Aircraft: bank angle phi = atan(V * turn_rate / g) in turns (coordinated turn).
   // Cars and ships: no bank in turns.
@@ -112,25 +117,56 @@ struct FigureEightSegment {
 
 // One command line of a gnss-ins-sim motion-definition file (after the initial-state line).
 // Angles are converted to radians; the file's column order is (yaw, pitch, roll) and the velocity
-// is in the body frame.
+// is in the body frame (forward-right-down).
+//
+// Meaning of the types (gnss-ins-sim README, "Motion definition", and the docstring of
+// gnss_ins_sim/pathgen/pathgen.py, github.com/Aceinna/gnss-ins-sim):
+//   1: Euler-angle rates [rad/s] and body-frame acceleration [m/s^2], held for duration_s.
+//   2: absolute attitude and absolute body velocity to reach.
+//   3: attitude change and body-velocity change.
+//   4: absolute attitude and body-velocity change.
+//   5: attitude change and absolute body velocity.
+// For types 2-5 duration_s is the maximum time: the next command starts as soon as the target is
+// reached, or after duration_s if it is not reached by then.
+//
+// How driftlab executes types 2-5 (its own design, see trajectory.cc): each of the six channels
+// (yaw, pitch, roll, v_x, v_y, v_z in the body frame) moves independently from its value at the
+// start of the command to its target. An Euler angle follows a rest-to-rest bang-coast-bang
+// profile: its rate ramps at +-max_angular_acceleration up to at most max_angular_rate, coasts, and
+// ramps back to zero exactly at the target (angle C^1, rate continuous). A body-velocity component
+// changes at the constant acceleration +-max_acceleration until it reaches its target. The command
+// ends when the slowest channel arrives, or is cut at duration_s (the channels then stop where they
+// are and the rates step to those of the next command). Absolute targets are taken literally
+// against the accumulated (unwrapped) Euler angles, as gnss-ins-sim does (target - current).
 struct GnssInsSimCommand {
-  int type = 1;                        // 1..5, gnss-ins-sim's documented meaning
+  int type = 1;                           // 1..5, gnss-ins-sim's documented meaning
   Vector3d euler_ypr = Vector3d::Zero();  // rad or rad/s depending on type (yaw, pitch, roll)
   Vector3d v_b = Vector3d::Zero();        // m/s or m/s^2 depending on type
-  double duration_s = 0.0;             // duration (type 1) or maximum duration (types 2-5)
+  double duration_s = 0.0;                // duration (type 1) or maximum duration (types 2-5)
   bool gps_visible = true;
+  // Where the command came from, e.g. "motion_def.csv:5", used as the field path of errors; empty
+  // for commands built in code (then the path is "<motion>.segments[i].gnss_ins_sim").
+  std::string source;
 };
 
-// Limits that gnss-ins-sim applies to commands of types 2-5 (its documented defaults).
+// Limits that gnss-ins-sim applies to commands of types 2-5. Defaults are that tool's built-in
+// 'high_mobility' mode, used when no mode is given: gnss_ins_sim/sim/ins_sim.py defines
+// `high_mobility = np.array([1.0, 0.5, 2.0])   # m/s/s, rad/s/s, rad/s` and Sim.__parse_mode()
+// returns it unconverted for mode=None, so the defaults are 1 m/s^2, 0.5 rad/s^2 (28.6 deg/s^2)
+// and 2 rad/s (114.6 deg/s). (A user-given mode array is in [m/s^2, deg/s^2, deg/s] and is
+// converted; the README's example passes mode=[1.0, 0.5, 2.0], i.e. 0.5 deg/s^2 and 2 deg/s.)
+// Each limit applies per channel: per body axis for the acceleration, per Euler angle for the
+// angular acceleration and rate (pathgen.py clips each component).
 struct GnssInsSimLimits {
-  double max_acceleration_m_per_s2 = 10.0;
-  double max_angular_acceleration_rad_per_s2 = 0.5 * M_PI / 180.0;
-  double max_angular_rate_rad_per_s = 2.0 * M_PI / 180.0;
+  double max_acceleration_m_per_s2 = 1.0;
+  double max_angular_acceleration_rad_per_s2 = 0.5;
+  double max_angular_rate_rad_per_s = 2.0;
 };
 
 // A truth profile (Groves' motion-profile layout): samples of time, LLH, NED velocity, attitude.
-// The kinematics between samples are the C^2 cubic-spline interpolants of velocity and Euler angles;
-// position is integrated from the interpolated velocity (the file's positions are only checked).
+// The kinematics between samples are the C^2 cubic-spline interpolants of velocity and Euler
+// angles; position is integrated from the interpolated velocity (the file's positions are only
+// checked).
 struct TruthProfileSample {
   double t_s = 0.0;
   Llh llh;
@@ -148,7 +184,7 @@ struct MotionSpec {
   std::optional<double> flat_gravity_m_per_s2;
   InitialState initial;
   VehicleOptions vehicle;
-  std::vector<Segment> segments;      // parametric / gnss-ins-sim commands, in order
+  std::vector<Segment> segments;  // parametric / gnss-ins-sim commands, in order
   GnssInsSimLimits gnss_ins_sim_limits;
   std::vector<TruthProfileSample> truth_profile;  // if non-empty: the whole motion (no segments)
   // Field-path prefix used in SpecError messages, e.g. "motion".
@@ -163,7 +199,8 @@ inline constexpr double kMaxDuration_s = 100000.0;
 // ---- Generated data ----------------------------------------------------------------------------
 
 // One output step k >= 1: the truth at t_k, the ideal increment over (t_{k-1}, t_k], and the point
-// sample at t_k.
+// sample at t_k (at a kink of the kinematics: the left limit, i.e. the end of the piece that ends
+// at t_k).
 struct TrajectorySample {
   NavState truth;
   ImuIncrement increment;
@@ -188,9 +225,12 @@ class TrajectoryGenerator {
   // Truth and point sample at t = 0.
   const NavState& initial_state() const;
   const ImuSample& initial_sample() const;
-  // Times at which the kinematics have a kink (segment boundaries, ramp ends), sorted.
+  // Times at which the kinematics have a kink (segment boundaries, ramp ends), sorted; interior
+  // times only (0 and the end are not listed).
   const std::vector<double>& breakpoints_s() const;
-  // True while the vehicle is static (speed and angular rate w.r.t. the Earth both zero) at t.
+  // True while the vehicle is static (speed and angular rate w.r.t. the Earth both exactly zero) at
+  // t, in [0, duration]; left-continuous like the point samples (true at the end time of a static
+  // segment).
   bool IsStaticAt(double t_s) const;
 
   // Advances one output step; false when the trajectory has ended.
