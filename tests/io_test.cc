@@ -43,7 +43,7 @@ std::vector<std::string> Lines(const std::filesystem::path& path) {
 }
 
 TEST(GnssInsSimMotion, ReadsTheNinetyDegreeTurnFile) {
-  const std::filesystem::path file = kData / "motion_def-90deg_turn.csv";
+  const std::filesystem::path file = kData / "gnss_ins_sim_90deg_turn.csv";
   const MotionSpec m = ReadGnssInsSimMotion(file);
   EXPECT_EQ(m.earth_model, EarthModel::kWgs84);
   EXPECT_DOUBLE_EQ(m.initial.llh.lat_rad, 31.9965 * kDeg);

@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -186,8 +187,9 @@ TEST(TrajectoryGenerator, IncrementsAt100HzEqualSummedIncrementsAt2000Hz) {
 // ---- gnss-ins-sim
 // ----------------------------------------------------------------------------------
 
-TEST(TrajectoryGenerator, GnssInsSim90DegreeTurnFileStartsAt315AndEndsAtYaw45Degrees) {
-  const MotionSpec m = ReadGnssInsSimMotion(kData / "motion_def-90deg_turn.csv");
+void Check90DegreeTurn(const std::filesystem::path& file) {
+  SCOPED_TRACE(file.string());
+  const MotionSpec m = ReadGnssInsSimMotion(file);
   TrajectoryGenerator g(m, 100.0);
   EXPECT_DOUBLE_EQ(g.duration_s(), 10.0);
   // Errata: starts at yaw 315 deg, turns at +15 deg/s for 6 s, ends at 45 deg. Tolerance 1e-9
@@ -199,6 +201,14 @@ TEST(TrajectoryGenerator, GnssInsSim90DegreeTurnFileStartsAt315AndEndsAtYaw45Deg
   // The body velocity (10 m/s forward) turned with the body: the final track is 45 deg too.
   EXPECT_NEAR(s.last.v_eb_n.x(), 10.0 * std::cos(45.0 * kDeg), 1e-9);
   EXPECT_NEAR(s.last.v_eb_n.y(), 10.0 * std::sin(45.0 * kDeg), 1e-9);
+}
+
+TEST(TrajectoryGenerator, GnssInsSim90DegreeTurnFileStartsAt315AndEndsAtYaw45Degrees) {
+  Check90DegreeTurn(kData / "gnss_ins_sim_90deg_turn.csv");
+  // The tool's own demo file, when a gnss-ins-sim checkout is given (not committed: third-party).
+  if (const char* dir = std::getenv("DRIFTLAB_GNSS_INS_SIM_DIR")) {
+    Check90DegreeTurn(std::filesystem::path(dir) / "demo_motion_def_files" / "motion_def-90deg_turn.csv");
+  }
 }
 
 TEST(TrajectoryGenerator, GnssInsSimTypes2To5ReachTargetsWithinTheLimits) {
