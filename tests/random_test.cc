@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/sample_statistics.h"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -148,20 +150,7 @@ TEST(RandomStreamTest, BlockFillIsIndependentOfSplitAndOrder) {
   EXPECT_EQ(Draw(stream, far, 8)[5], stream.Gaussian(far + 5));
 }
 
-double Correlation(const std::vector<double>& a, const std::vector<double>& b) {
-  long double sab = 0, saa = 0, sbb = 0, sa = 0, sb = 0;
-  const size_t n = a.size();
-  for (size_t i = 0; i < n; ++i) {
-    sa += a[i];
-    sb += b[i];
-    sab += static_cast<long double>(a[i]) * b[i];
-    saa += static_cast<long double>(a[i]) * a[i];
-    sbb += static_cast<long double>(b[i]) * b[i];
-  }
-  const long double cov = sab / n - (sa / n) * (sb / n);
-  return static_cast<double>(
-      cov / std::sqrt((saa / n - (sa / n) * (sa / n)) * (sbb / n - (sb / n) * (sb / n))));
-}
+using driftlab::testing::SampleCorrelation;
 
 TEST(RandomStreamTest, DifferentKeysGiveUncorrelatedStreams) {
   // Sample correlation of independent streams: sd 1/sqrt(n); bound kZ / sqrt(n) per pair.
@@ -179,12 +168,12 @@ TEST(RandomStreamTest, DifferentKeysGiveUncorrelatedStreams) {
   };
   const double bound = kZ / std::sqrt(static_cast<double>(n));
   for (size_t s = 0; s < others.size(); ++s) {
-    EXPECT_LT(std::fabs(Correlation(a, Draw(others[s], 0, n))), bound) << "pair " << s;
+    EXPECT_LT(std::fabs(SampleCorrelation(a, Draw(others[s], 0, n))), bound) << "pair " << s;
   }
   // Within one stream: lags 1 (same Box-Muller pair), 2, 4 (next block) are uncorrelated.
   for (size_t lag : {1u, 2u, 4u}) {
     std::vector<double> x(a.begin(), a.end() - lag), y(a.begin() + lag, a.end());
-    EXPECT_LT(std::fabs(Correlation(x, y)), bound) << "lag " << lag;
+    EXPECT_LT(std::fabs(SampleCorrelation(x, y)), bound) << "lag " << lag;
   }
   // The pair (z0, z1) of one Box-Muller draw: z0^2 and z1^2 are independent (sd of the
   // correlation estimate is again 1/sqrt(n') for n' pairs).
@@ -193,7 +182,7 @@ TEST(RandomStreamTest, DifferentKeysGiveUncorrelatedStreams) {
     q0.push_back(a[i] * a[i]);
     q1.push_back(a[i + 1] * a[i + 1]);
   }
-  EXPECT_LT(std::fabs(Correlation(q0, q1)), kZ / std::sqrt(static_cast<double>(q0.size())));
+  EXPECT_LT(std::fabs(SampleCorrelation(q0, q1)), kZ / std::sqrt(static_cast<double>(q0.size())));
 }
 
 TEST(RandomStreamTest, UniformDeviatesAreInOpenUnitIntervalWithMeanOneHalf) {

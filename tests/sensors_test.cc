@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/sample_statistics.h"
+
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -180,20 +182,7 @@ TEST(SensorReproducibilityTest, SameSeedGivesBitIdenticalRunsInAnyOrderOnOneOrTw
   EXPECT_FALSE(BitIdentical(forward[0], forward[1]));
 }
 
-double Correlation(const std::vector<double>& a, const std::vector<double>& b) {
-  long double sab = 0, saa = 0, sbb = 0, sa = 0, sb = 0;
-  const size_t n = a.size();
-  for (size_t i = 0; i < n; ++i) {
-    sa += a[i];
-    sb += b[i];
-    sab += static_cast<long double>(a[i]) * b[i];
-    saa += static_cast<long double>(a[i]) * a[i];
-    sbb += static_cast<long double>(b[i]) * b[i];
-  }
-  const long double cov = sab / n - (sa / n) * (sb / n);
-  return static_cast<double>(
-      cov / std::sqrt((saa / n - (sa / n) * (sa / n)) * (sbb / n - (sb / n) * (sb / n))));
-}
+using driftlab::testing::SampleCorrelation;
 
 TEST(SensorReproducibilityTest, DifferentRunsAxesAndSensorsHaveUncorrelatedNoise) {
   // White noise only: the sample correlation of independent series of n samples has sd
@@ -217,12 +206,12 @@ TEST(SensorReproducibilityTest, DifferentRunsAxesAndSensorsHaveUncorrelatedNoise
   };
   const auto run0 = series(0), run1 = series(1);
   const double bound = kZ / std::sqrt(static_cast<double>(n));
-  EXPECT_LT(std::fabs(Correlation(run0[0], run1[0])), bound);  // gyro x, run 0 vs 1
-  EXPECT_LT(std::fabs(Correlation(run0[3], run1[3])), bound);  // accel x, run 0 vs 1
-  EXPECT_LT(std::fabs(Correlation(run0[0], run0[1])), bound);  // gyro x vs y
-  EXPECT_LT(std::fabs(Correlation(run0[1], run0[2])), bound);  // gyro y vs z
-  EXPECT_LT(std::fabs(Correlation(run0[0], run0[3])), bound);  // gyro x vs accel x
-  EXPECT_LT(std::fabs(Correlation(run0[2], run0[5])), bound);  // gyro z vs accel z
+  EXPECT_LT(std::fabs(SampleCorrelation(run0[0], run1[0])), bound);  // gyro x, run 0 vs 1
+  EXPECT_LT(std::fabs(SampleCorrelation(run0[3], run1[3])), bound);  // accel x, run 0 vs 1
+  EXPECT_LT(std::fabs(SampleCorrelation(run0[0], run0[1])), bound);  // gyro x vs y
+  EXPECT_LT(std::fabs(SampleCorrelation(run0[1], run0[2])), bound);  // gyro y vs z
+  EXPECT_LT(std::fabs(SampleCorrelation(run0[0], run0[3])), bound);  // gyro x vs accel x
+  EXPECT_LT(std::fabs(SampleCorrelation(run0[2], run0[5])), bound);  // gyro z vs accel z
 }
 
 TEST(SensorDeterministicTermsTest, ScaleFactorAndMisalignmentGiveExactlyIPlusSPlusMTimesInput) {
