@@ -7,12 +7,12 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <regex>
 #include <set>
 #include <string>
 
 #include "driftlab/sensors.h"
 #include "driftlab/spec_error.h"
+#include "driftlab/units.h"
 
 namespace driftlab {
 namespace {
@@ -64,13 +64,30 @@ TEST(ImuCatalogue, EveryDescriptionCitesASourceAndStatesItsAssumptions) {
   }
 }
 
+// Lowercase words of [a-z0-9] joined by single dashes: "a", "icm-42688-p"; not "A", "-a", "a--b".
+bool IsLowercaseWithDashes(const std::string& name) {
+  if (name.empty() || name.front() == '-' || name.back() == '-') return false;
+  for (size_t i = 0; i < name.size(); ++i) {
+    const char c = name[i];
+    const bool word_char = (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9');
+    if (c == '-') {
+      if (name[i - 1] == '-') return false;
+    } else if (!word_char) {
+      return false;
+    }
+  }
+  return true;
+}
+
 TEST(ImuCatalogue, NamesAreUniqueLowercaseWithDashes) {
-  const std::regex pattern("[a-z0-9]+(-[a-z0-9]+)*");
   std::set<std::string> names;
   for (const ImuErrorModel& model : ImuCatalogue()) {
-    EXPECT_TRUE(std::regex_match(model.name, pattern)) << model.name;
+    EXPECT_TRUE(IsLowercaseWithDashes(model.name)) << model.name;
     EXPECT_TRUE(names.insert(model.name).second) << "duplicate " << model.name;
   }
+  EXPECT_FALSE(IsLowercaseWithDashes("Tactical"));  // the checker itself rejects bad names
+  EXPECT_FALSE(IsLowercaseWithDashes("a--b"));
+  EXPECT_FALSE(IsLowercaseWithDashes("adis16470-"));
   // Brief: five grades, seed 000, seed 002 (3), seed 003 and at least eight datasheet IMUs.
   EXPECT_GE(names.size(), 18u);
 }
@@ -215,6 +232,39 @@ TEST(UnitConversions, DatasheetFiguresConvertToSiByHand) {
   // 2.8 mdps/sqrt(Hz) = 0.0028 pi/180 rad/sqrt(s).
   ExpectRelNear(FindImuPreset("icm-42688-p").gyro.white_noise_density, 0.0028 * kPi / 180.0,
                 "ICM-42688-P gyro noise");
+}
+
+TEST(UnitConversions, CatalogueAgreesWithTheUnitsModule) {
+  // The catalogue converts with its own constexpr helpers; the units module (units.h) parses the
+  // same datasheet quantities independently. Both must give the same SI value.
+  struct Case {
+    double value_si;
+    double value;
+    const char* unit;
+    Dimension dimension;
+  };
+  const Case cases[] = {
+      {FindImuPreset("tactical").gyro.white_noise_density, 0.15, "deg/sqrt(h)",
+       dims::kAngleRandomWalk},
+      {FindImuPreset("navigation").gyro.bias_flicker.bias_instability, 0.003, "deg/h",
+       dims::kAngularRate},
+      {FindImuPreset("tactical").accel.white_noise_density, 150.0, "ug/sqrt(Hz)",
+       dims::kVelocityRandomWalk},
+      {FindImuPreset("seed002-crossbow-dmu").accel.turn_on_bias_sigma, 24.0, "mg",
+       dims::kAcceleration},
+      {FindImuPreset("stim300").accel.white_noise_density, 0.06, "m/s/sqrt(h)",
+       dims::kVelocityRandomWalk},
+      {FindImuPreset("hg1700").accel.white_noise_density, 0.065, "ft/s/sqrt(h)",
+       dims::kVelocityRandomWalk},
+      {FindImuPreset("adis16470").gyro.white_noise_density, 0.008, "(deg/s)/sqrt(Hz)",
+       dims::kAngleRandomWalk},
+      {FindImuPreset("stim300").gyro.scale_factor_sigma, 500.0, "ppm", dims::kDimensionless},
+      {FindImuPreset("seed002-crossbow-dmu").gyro.scale_factor_sigma, 1.5, "%",
+       dims::kDimensionless},
+  };
+  for (const Case& c : cases) {
+    ExpectRelNear(c.value_si, ToSi(c.value, c.unit, c.dimension), c.unit);
+  }
 }
 
 TEST(UnitConversions, AgreesWithSeed001RoundedEquivalences) {

@@ -4,12 +4,12 @@
 
 #include <gtest/gtest.h>
 
-#include "support/sample_statistics.h"
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <vector>
+
+#include "support/sample_statistics.h"
 
 namespace driftlab {
 namespace {

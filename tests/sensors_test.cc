@@ -4,8 +4,6 @@
 
 #include <gtest/gtest.h>
 
-#include "support/sample_statistics.h"
-
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -14,6 +12,7 @@
 
 #include "driftlab/allan.h"
 #include "driftlab/spec_error.h"
+#include "support/sample_statistics.h"
 
 namespace driftlab {
 namespace {

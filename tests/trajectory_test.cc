@@ -8,8 +8,8 @@
 
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -207,7 +207,8 @@ TEST(TrajectoryGenerator, GnssInsSim90DegreeTurnFileStartsAt315AndEndsAtYaw45Deg
   Check90DegreeTurn(kData / "gnss_ins_sim_90deg_turn.csv");
   // The tool's own demo file, when a gnss-ins-sim checkout is given (not committed: third-party).
   if (const char* dir = std::getenv("DRIFTLAB_GNSS_INS_SIM_DIR")) {
-    Check90DegreeTurn(std::filesystem::path(dir) / "demo_motion_def_files" / "motion_def-90deg_turn.csv");
+    Check90DegreeTurn(std::filesystem::path(dir) / "demo_motion_def_files" /
+                      "motion_def-90deg_turn.csv");
   }
 }
 

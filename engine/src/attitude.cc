@@ -20,7 +20,7 @@ Matrix3d EulerToDcm(const EulerAngles& e) {
   // Transpose of Groves (2.22) (which gives C_n_b).
   Matrix3d C_b_n;
   C_b_n << ct * cs, -cp * ss + sp * st * cs, sp * ss + cp * st * cs,  //
-      ct * ss, cp * cs + sp * st * ss, -sp * cs + cp * st * ss,        //
+      ct * ss, cp * cs + sp * st * ss, -sp * cs + cp * st * ss,       //
       -st, sp * ct, cp * ct;
   return C_b_n;
 }

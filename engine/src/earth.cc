@@ -18,8 +18,8 @@ double TransverseRadius(double L_b) {
 double SomiglianaGravity(double L_b) {
   // k = b gamma_p / (a gamma_e) - 1, Groves (2.134) / NIMA TR8350.2 (4-1).
   const double k = kWgs84SemiMinorAxis_m * kWgs84GammaPole_m_per_s2 /
-                        (kWgs84SemiMajorAxis_m * kWgs84GammaEquator_m_per_s2) -
-                    1.0;
+                       (kWgs84SemiMajorAxis_m * kWgs84GammaEquator_m_per_s2) -
+                   1.0;
   const double s2 = std::sin(L_b) * std::sin(L_b);
   return kWgs84GammaEquator_m_per_s2 * (1.0 + k * s2) / std::sqrt(1.0 - kWgs84Eccentricity2 * s2);
 }
@@ -33,8 +33,8 @@ Vector3d GravityNed(double L_b, double h_b) {
   const double m = kWgs84EarthRate_rad_per_s * kWgs84EarthRate_rad_per_s * a * a *
                    kWgs84SemiMinorAxis_m / kWgs84GM_m3_per_s2;
   const double g0 = SomiglianaGravity(L_b);
-  const double g_D = g0 * (1.0 - 2.0 / a * (1.0 + f * (1.0 - 2.0 * s2) + m) * h_b +
-                           3.0 * h_b * h_b / (a * a));
+  const double g_D =
+      g0 * (1.0 - 2.0 / a * (1.0 + f * (1.0 - 2.0 * s2) + m) * h_b + 3.0 * h_b * h_b / (a * a));
   const double g_N = -8.08e-9 * h_b * std::sin(2.0 * L_b);
   return Vector3d(g_N, 0.0, g_D);
 }
@@ -73,7 +73,8 @@ Llh EcefToLlh(const Vector3d& r_eb_e) {
   // of L = atan((z + e^2 R_E sin L) / p), which converges quadratically from this start.
   const double ep2 = e2 / (1.0 - e2);
   const double u = std::atan2(z * a, p * b);
-  double L = std::atan2(z + ep2 * b * std::pow(std::sin(u), 3), p - e2 * a * std::pow(std::cos(u), 3));
+  double L =
+      std::atan2(z + ep2 * b * std::pow(std::sin(u), 3), p - e2 * a * std::pow(std::cos(u), 3));
   for (int i = 0; i < 8; ++i) {
     const double R_E = TransverseRadius(L);
     const double L_next = std::atan2(z + e2 * R_E * std::sin(L), p);

@@ -2,7 +2,8 @@
 
 namespace driftlab {
 
-NavError ComputeNavError(const NavEnvironment& env, const NavState& estimate, const NavState& truth) {
+NavError ComputeNavError(const NavEnvironment& env, const NavState& estimate,
+                         const NavState& truth) {
   NavError e;
   e.r_ned_m = env.PositionErrorNed(estimate.llh, truth.llh);
   e.v_ned_m_per_s = estimate.v_eb_n - truth.v_eb_n;

@@ -18,23 +18,24 @@ using Eigen::Matrix3d;
 using Eigen::Vector3d;
 
 // WGS-84 defining and derived constants (NIMA TR8350.2 tables 3.1 and 3.3).
-inline constexpr double kWgs84SemiMajorAxis_m = 6378137.0;            // a, R_0
-inline constexpr double kWgs84Flattening = 1.0 / 298.257223563;       // f
-inline constexpr double kWgs84Eccentricity2 =                          // e^2 = f (2 - f)
+inline constexpr double kWgs84SemiMajorAxis_m = 6378137.0;       // a, R_0
+inline constexpr double kWgs84Flattening = 1.0 / 298.257223563;  // f
+inline constexpr double kWgs84Eccentricity2 =                    // e^2 = f (2 - f)
     kWgs84Flattening * (2.0 - kWgs84Flattening);
-inline constexpr double kWgs84SemiMinorAxis_m =                        // b = a (1 - f)
+inline constexpr double kWgs84SemiMinorAxis_m =  // b = a (1 - f)
     kWgs84SemiMajorAxis_m * (1.0 - kWgs84Flattening);
-inline constexpr double kWgs84EarthRate_rad_per_s = 7.292115e-5;       // omega_ie
-inline constexpr double kWgs84GM_m3_per_s2 = 3.986004418e14;           // mu
-inline constexpr double kWgs84GammaEquator_m_per_s2 = 9.7803253359;    // normal gravity, L = 0
-inline constexpr double kWgs84GammaPole_m_per_s2 = 9.8321849378;       // normal gravity, L = 90 deg
+inline constexpr double kWgs84EarthRate_rad_per_s = 7.292115e-5;     // omega_ie
+inline constexpr double kWgs84GM_m3_per_s2 = 3.986004418e14;         // mu
+inline constexpr double kWgs84GammaEquator_m_per_s2 = 9.7803253359;  // normal gravity, L = 0
+inline constexpr double kWgs84GammaPole_m_per_s2 = 9.8321849378;     // normal gravity, L = 90 deg
 
 // Standard gravity (CGPM 1901), used only for converting g-based datasheet units.
 inline constexpr double kStandardGravity_m_per_s2 = 9.80665;
 
 // Meridian radius of curvature R_N(L) = a (1 - e^2) / (1 - e^2 sin^2 L)^(3/2). Groves (2.105).
 double MeridianRadius(double L_b);
-// Transverse (prime-vertical) radius of curvature R_E(L) = a / sqrt(1 - e^2 sin^2 L). Groves (2.106).
+// Transverse (prime-vertical) radius of curvature R_E(L) = a / sqrt(1 - e^2 sin^2 L). Groves
+// (2.106).
 double TransverseRadius(double L_b);
 
 // Magnitude of normal gravity on the ellipsoid surface, Somigliana's closed formula
@@ -94,8 +95,8 @@ class NavEnvironment {
   // Radii used for d(L)/dt = v_N / (R_N + h) and d(lambda)/dt = v_E / ((R_E + h) cos L).
   double MeridianRadiusAt(double L_b) const;
   double TransverseRadiusAt(double L_b) const;
-  Vector3d Gravity(double L_b, double h_b) const;                 // g_b_n
-  Vector3d EarthRate(double L_b) const;                           // omega_ie_n
+  Vector3d Gravity(double L_b, double h_b) const;                                // g_b_n
+  Vector3d EarthRate(double L_b) const;                                          // omega_ie_n
   Vector3d TransportRate(double L_b, double h_b, const Vector3d& v_eb_n) const;  // omega_en_n
   // Rate of change of (L, lambda, h) for NED velocity v_eb_n. Groves (2.111).
   Vector3d LlhRate(double L_b, double h_b, const Vector3d& v_eb_n) const;

@@ -12,9 +12,9 @@ namespace driftlab {
 
 struct NavState {
   double t_s = 0.0;
-  Llh llh;                                          // L_b, lambda_b [rad], h_b [m]
-  Vector3d v_eb_n = Vector3d::Zero();               // [m/s] NED
-  Quaterniond q_b_n = Quaterniond::Identity();      // body -> NED
+  Llh llh;                                      // L_b, lambda_b [rad], h_b [m]
+  Vector3d v_eb_n = Vector3d::Zero();           // [m/s] NED
+  Quaterniond q_b_n = Quaterniond::Identity();  // body -> NED
 
   Matrix3d C_b_n() const { return q_b_n.toRotationMatrix(); }
   EulerAngles euler() const { return DcmToEuler(C_b_n()); }
@@ -36,12 +36,13 @@ struct ImuSample {
 
 // Navigation errors of an estimate against the truth at one epoch.
 struct NavError {
-  Vector3d r_ned_m = Vector3d::Zero();       // position error N, E, D [m]
-  Vector3d v_ned_m_per_s = Vector3d::Zero(); // velocity error N, E, D [m/s]
-  Vector3d euler_rad = Vector3d::Zero();     // roll, pitch, yaw differences, wrapped [rad]
-  Vector3d psi_nb_n_rad = Vector3d::Zero();  // attitude error as rotation vector in n [rad]
+  Vector3d r_ned_m = Vector3d::Zero();        // position error N, E, D [m]
+  Vector3d v_ned_m_per_s = Vector3d::Zero();  // velocity error N, E, D [m/s]
+  Vector3d euler_rad = Vector3d::Zero();      // roll, pitch, yaw differences, wrapped [rad]
+  Vector3d psi_nb_n_rad = Vector3d::Zero();   // attitude error as rotation vector in n [rad]
 };
 
-NavError ComputeNavError(const NavEnvironment& env, const NavState& estimate, const NavState& truth);
+NavError ComputeNavError(const NavEnvironment& env, const NavState& estimate,
+                         const NavState& truth);
 
 }  // namespace driftlab
