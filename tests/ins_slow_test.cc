@@ -10,6 +10,7 @@
 
 #include "driftlab/simulate.h"
 #include "driftlab/trajectory.h"
+#include "support/motion_builders.h"
 
 namespace driftlab {
 namespace {
@@ -96,13 +97,7 @@ TurnSegment TurnByRadius(double radius_m, bool right, double angle_deg, double t
   return t;
 }
 
-TurnSegment TurnByRate(double rate_deg_per_s, double angle_deg, double transition_s) {
-  TurnSegment t;
-  t.rate_rad_per_s = rate_deg_per_s * kDeg;
-  t.angle_rad = angle_deg * kDeg;
-  t.transition_s = transition_s;
-  return t;
-}
+using testing::TurnByRate;
 
 TEST(InsClosureSlowTest, CarDriveWithTurnsAndStopsClosesAfterAnHour) {
   // examples/car_drive.json (town drive, ~9.5 min) repeated seven times.

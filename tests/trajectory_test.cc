@@ -15,6 +15,7 @@
 
 #include "driftlab/io.h"
 #include "driftlab/spec_error.h"
+#include "support/motion_builders.h"
 
 namespace driftlab {
 namespace {
@@ -33,11 +34,7 @@ MotionSpec Motion(EarthModel model, double lat_deg, const Vector3d& v_eb_n, doub
 }
 
 TurnSegment Turn(double rate_deg_per_s, double angle_deg, double transition_s) {
-  TurnSegment t;
-  t.rate_rad_per_s = rate_deg_per_s * kDeg;
-  t.angle_rad = angle_deg * kDeg;
-  t.transition_s = transition_s;
-  return t;
+  return testing::TurnByRate(rate_deg_per_s, angle_deg, transition_s);
 }
 
 struct Sums {
