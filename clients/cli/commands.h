@@ -1,21 +1,36 @@
-// The `driftlab` commands, one file each; main.cc parses the command line and dispatches here.
+// The `driftlab` commands, one file each. Every command file registers itself with a static
+// RegisterCommand object: main.cc builds the CLI11 app from the registry (sorted by name, so the
+// help text does not depend on link order) and runs the one subcommand given.
 #pragma once
 
+#include <CLI/CLI.hpp>
+#include <functional>
 #include <string>
+#include <vector>
 
 namespace driftlab::cli {
 
 // Exit statuses shared by every command.
 inline constexpr int kExitOk = 0;
-inline constexpr int kExitFailure = 1;  // I/O or internal error
-inline constexpr int kExitBadJob = 2;   // invalid job file or command line
+inline constexpr int kExitFailure = 1;  // I/O or internal error (and `gate`: a regression)
+inline constexpr int kExitBadJob = 2;   // invalid job file, data file or command line
 
-// `driftlab validate JOB`: prints "OK" or the first error of the job.
-int RunValidate(const std::string& job_path);
+// Declares one subcommand on `app` (options bound to state the closure owns) and returns the
+// function that runs it after parsing, returning the exit status.
+using AddCommand = std::function<std::function<int()>(CLI::App& app)>;
 
-// `driftlab simulate JOB --out DIR`: error-free simulation of the job's motion through its
-// mechanization; writes truth.csv, imu.csv, nav.csv, errors.csv to DIR and prints a summary. The
-// job is validated completely before DIR is created.
-int RunSimulate(const std::string& job_path, const std::string& out_dir);
+struct CommandEntry {
+  std::string name;  // for ordering only
+  AddCommand add;
+};
+
+// All registered commands (static registration from each command's file).
+std::vector<CommandEntry>& CommandRegistry();
+
+struct RegisterCommand {
+  RegisterCommand(std::string name, AddCommand add) {
+    CommandRegistry().push_back({std::move(name), std::move(add)});
+  }
+};
 
 }  // namespace driftlab::cli

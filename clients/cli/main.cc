@@ -1,27 +1,35 @@
-// driftlab: command-line client. Parses the command line and dispatches to one file per command.
+// driftlab: command-line client. Builds the command line from the registered commands
+// (commands.h; one file per command) and runs the one given.
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "commands.h"
 
+namespace driftlab::cli {
+
+std::vector<CommandEntry>& CommandRegistry() {
+  static std::vector<CommandEntry> registry;
+  return registry;
+}
+
+}  // namespace driftlab::cli
+
 int main(int argc, char** argv) {
+  using driftlab::cli::CommandRegistry;
   CLI::App app{"driftlab: inertial navigation error analysis"};
   app.set_version_flag("--version", std::string("driftlab ") + DRIFTLAB_VERSION);
   app.require_subcommand(1);
 
-  std::string job_path;
-  std::string out_dir = "driftlab-out";
-
-  CLI::App* simulate =
-      app.add_subcommand("simulate",
-                         "Run a job's motion through its mechanization on error-free "
-                         "IMU data; write truth.csv, imu.csv, nav.csv, errors.csv");
-  simulate->add_option("job", job_path, "Job file (.json, .yaml, .yml)")->required();
-  simulate->add_option("--out,-o", out_dir, "Output directory (created if absent)")
-      ->capture_default_str();
-
-  CLI::App* validate = app.add_subcommand("validate", "Check a job file; print OK or the error");
-  validate->add_option("job", job_path, "Job file (.json, .yaml, .yml)")->required();
+  auto& registry = CommandRegistry();
+  std::sort(registry.begin(), registry.end(),
+            [](const auto& a, const auto& b) { return a.name < b.name; });
+  std::vector<std::function<int()>> runners;
+  runners.reserve(registry.size());
+  for (const auto& entry : registry) runners.push_back(entry.add(app));
 
   try {
     app.parse(argc, argv);
@@ -30,6 +38,10 @@ int main(int argc, char** argv) {
     // --help and --version exit 0; a wrong command line is bad input like a bad job.
     return status == 0 ? driftlab::cli::kExitOk : driftlab::cli::kExitBadJob;
   }
-  if (simulate->parsed()) return driftlab::cli::RunSimulate(job_path, out_dir);
-  return driftlab::cli::RunValidate(job_path);
+  const auto subcommands = app.get_subcommands();
+  const CLI::App* given = subcommands.front();
+  for (size_t i = 0; i < registry.size(); ++i) {
+    if (given->get_name() == registry[i].name) return runners[i]();
+  }
+  return driftlab::cli::kExitFailure;  // unreachable: CLI11 accepts registered names only
 }

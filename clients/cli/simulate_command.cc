@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
+#include <string>
 #include <system_error>
 
 #include "commands.h"
@@ -45,8 +47,6 @@ void PrintSummary(const jobspec::JobFile& file, const SimulationSpec& spec,
   fmt::print("wrote truth.csv, imu.csv, nav.csv, errors.csv to {}\n", out_dir.string());
 }
 
-}  // namespace
-
 int RunSimulate(const std::string& job_path, const std::string& out_dir) {
   jobspec::JobFile file;
   SimulationSpec spec;
@@ -83,4 +83,21 @@ int RunSimulate(const std::string& job_path, const std::string& out_dir) {
   return kExitOk;
 }
 
+const RegisterCommand kSimulate("simulate", [](CLI::App& app) -> std::function<int()> {
+  struct Options {
+    std::string job_path;
+    std::string out_dir = "driftlab-out";
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* command = app.add_subcommand(
+      "simulate",
+      "Run a job's motion through its mechanization (one seeded run of its sensor model, or "
+      "error-free IMU data without one); write truth.csv, imu.csv, nav.csv, errors.csv");
+  command->add_option("job", options->job_path, "Job file (.json, .yaml, .yml)")->required();
+  command->add_option("--out,-o", options->out_dir, "Output directory (created if absent)")
+      ->capture_default_str();
+  return [options] { return RunSimulate(options->job_path, options->out_dir); };
+});
+
+}  // namespace
 }  // namespace driftlab::cli

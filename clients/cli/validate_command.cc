@@ -1,6 +1,9 @@
+// `driftlab validate JOB`: prints "OK" or the first error of the job (exit 2).
 #include <fmt/format.h>
 
 #include <cstdio>
+#include <memory>
+#include <string>
 
 #include "commands.h"
 #include "driftlab/jobspec/job_file.h"
@@ -8,6 +11,7 @@
 #include "driftlab/spec_error.h"
 
 namespace driftlab::cli {
+namespace {
 
 int RunValidate(const std::string& job_path) {
   try {
@@ -20,4 +24,12 @@ int RunValidate(const std::string& job_path) {
   return kExitOk;
 }
 
+const RegisterCommand kValidate("validate", [](CLI::App& app) -> std::function<int()> {
+  auto job_path = std::make_shared<std::string>();
+  CLI::App* command = app.add_subcommand("validate", "Check a job file; print OK or the error");
+  command->add_option("job", *job_path, "Job file (.json, .yaml, .yml)")->required();
+  return [job_path] { return RunValidate(*job_path); };
+});
+
+}  // namespace
 }  // namespace driftlab::cli
