@@ -7,12 +7,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <system_error>
 
 #include "commands.h"
 #include "driftlab/io.h"
 #include "driftlab/jobspec/job_file.h"
+#include "driftlab/jobspec/sensor_model.h"
 #include "driftlab/jobspec/translate.h"
 #include "driftlab/simulate.h"
 #include "driftlab/spec_error.h"
@@ -22,13 +24,19 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 
-void PrintSummary(const jobspec::JobFile& file, const SimulationSpec& spec,
+void PrintSummary(const jobspec::JobFile& file, const SimulationSpec& spec, const SensorRun* sensor,
                   const SimulationSummary& summary, const std::filesystem::path& out_dir) {
   const std::string name = file.job.name().empty() ? "(unnamed)" : file.job.name();
   fmt::print("{}: {:.3f} s, {} steps at {:g} Hz, {} mechanization, {} earth\n", name,
              summary.duration_s, summary.steps, spec.rate_hz,
              spec.mechanization == MechanizationKind::kNed ? "NED" : "SEED000",
              spec.motion.earth_model == EarthModel::kWgs84 ? "WGS84" : "FLAT");
+  if (sensor != nullptr) {
+    fmt::print("sensor model {}, seed {}, run {}\n", sensor->model.name, sensor->seed,
+               sensor->run_index);
+  } else {
+    fmt::print("error-free IMU data (the job has no sensor model)\n");
+  }
   const NavError& final_error = summary.final_error;
   fmt::print("{:<26}{:>14}{:>14}\n", "error", "final", "max");
   auto row = [](const char* label, double final_value, double max_value) {
@@ -44,15 +52,29 @@ void PrintSummary(const jobspec::JobFile& file, const SimulationSpec& spec,
       summary.max_abs_euler_rad.y() * kRadToDeg);
   row("yaw [deg]", std::abs(final_error.euler_rad.z()) * kRadToDeg,
       summary.max_abs_euler_rad.z() * kRadToDeg);
-  fmt::print("wrote truth.csv, imu.csv, nav.csv, errors.csv to {}\n", out_dir.string());
+  fmt::print("wrote truth.csv, imu.csv, {}nav.csv, errors.csv to {}\n",
+             sensor != nullptr ? "imu_ideal.csv, " : "", out_dir.string());
 }
 
-int RunSimulate(const std::string& job_path, const std::string& out_dir) {
+struct SimulateOptions {
+  std::string job_path;
+  std::string out_dir = "driftlab-out";
+  std::optional<uint64_t> seed;
+  uint32_t run_index = 0;
+};
+
+int RunSimulate(const SimulateOptions& options) {
+  const std::string& out_dir = options.out_dir;
   jobspec::JobFile file;
   SimulationSpec spec;
+  std::optional<SensorRun> sensor;
   try {
-    file = jobspec::LoadJobFile(job_path);
+    file = jobspec::LoadJobFile(options.job_path);
     spec = jobspec::ValidateJob(file);
+    if (std::optional<ImuErrorModel> model = jobspec::ToImuErrorModel(file.job)) {
+      sensor = SensorRun{*std::move(model), options.seed.value_or(jobspec::JobSeed(file.job)),
+                         options.run_index};
+    }
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;
@@ -67,11 +89,12 @@ int RunSimulate(const std::string& job_path, const std::string& out_dir) {
     return kExitFailure;
   }
   try {
-    SimulationCsvWriters writers(dir);
-    const SimulationSummary summary = RunErrorFreeSimulation(
-        spec, [&writers](const SimulationStep& step) { writers.Write(step); });
+    const SensorRun* run = sensor ? &*sensor : nullptr;
+    SimulationCsvWriters writers(dir, /*ideal_imu=*/run != nullptr);
+    const SimulationSummary summary =
+        RunSimulation(spec, run, [&writers](const SimulationStep& step) { writers.Write(step); });
     writers.Close();
-    PrintSummary(file, spec, summary, dir);
+    PrintSummary(file, spec, run, summary, dir);
   } catch (const SpecError& e) {
     // The engine may still reject a job after planning (a check made while integrating).
     fmt::print(stderr, "error: {}\n", e.what());
@@ -84,11 +107,7 @@ int RunSimulate(const std::string& job_path, const std::string& out_dir) {
 }
 
 const RegisterCommand kSimulate("simulate", [](CLI::App& app) -> std::function<int()> {
-  struct Options {
-    std::string job_path;
-    std::string out_dir = "driftlab-out";
-  };
-  auto options = std::make_shared<Options>();
+  auto options = std::make_shared<SimulateOptions>();
   CLI::App* command = app.add_subcommand(
       "simulate",
       "Run a job's motion through its mechanization (one seeded run of its sensor model, or "
@@ -96,7 +115,10 @@ const RegisterCommand kSimulate("simulate", [](CLI::App& app) -> std::function<i
   command->add_option("job", options->job_path, "Job file (.json, .yaml, .yml)")->required();
   command->add_option("--out,-o", options->out_dir, "Output directory (created if absent)")
       ->capture_default_str();
-  return [options] { return RunSimulate(options->job_path, options->out_dir); };
+  command->add_option("--seed", options->seed, "Random seed (default: the job's monte_carlo.seed)");
+  command->add_option("--run", options->run_index, "Run index of the sensor errors")
+      ->capture_default_str();
+  return [options] { return RunSimulate(*options); };
 });
 
 }  // namespace

@@ -7,6 +7,7 @@
 
 #include "commands.h"
 #include "driftlab/jobspec/job_file.h"
+#include "driftlab/jobspec/sensor_model.h"
 #include "driftlab/jobspec/translate.h"
 #include "driftlab/spec_error.h"
 
@@ -15,7 +16,9 @@ namespace {
 
 int RunValidate(const std::string& job_path) {
   try {
-    jobspec::ValidateJob(jobspec::LoadJobFile(job_path));
+    const jobspec::JobFile file = jobspec::LoadJobFile(job_path);
+    jobspec::ValidateJob(file);
+    jobspec::ToImuErrorModel(file.job);
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;

@@ -374,16 +374,21 @@ void GrovesProfileWriter::Write(const NavState& s) {
   Row(v, 10);
 }
 
-SimulationCsvWriters::SimulationCsvWriters(const std::filesystem::path& dir)
+SimulationCsvWriters::SimulationCsvWriters(const std::filesystem::path& dir, bool ideal_imu)
     : truth_(dir / "truth.csv"),
       imu_(dir / "imu.csv"),
       nav_(dir / "nav.csv"),
-      errors_(dir / "errors.csv") {}
+      errors_(dir / "errors.csv") {
+  if (ideal_imu) imu_ideal_.emplace(dir / "imu_ideal.csv");
+}
 
 void SimulationCsvWriters::Write(const SimulationStep& step) {
   const double t_s = step.truth->t_s;
   truth_.Write(*step.truth);
-  imu_.Write(t_s, *step.increment, *step.sample);
+  const bool measured = step.measured_increment != nullptr && step.measured_sample != nullptr;
+  imu_.Write(t_s, measured ? *step.measured_increment : *step.increment,
+             measured ? *step.measured_sample : *step.sample);
+  if (imu_ideal_) imu_ideal_->Write(t_s, *step.increment, *step.sample);
   nav_.Write(*step.nav);
   errors_.Write(t_s, *step.error);
 }
@@ -391,6 +396,7 @@ void SimulationCsvWriters::Write(const SimulationStep& step) {
 void SimulationCsvWriters::Close() {
   truth_.Close();
   imu_.Close();
+  if (imu_ideal_) imu_ideal_->Close();
   nav_.Close();
   errors_.Close();
 }

@@ -1,5 +1,5 @@
-// Error-free simulation loop: ideal IMU data from the trajectory generator through mechanization A
-// or B, errors against the truth at every output step.
+// Single-run simulation loop: ideal IMU data from the trajectory generator, optionally through a
+// sensor error model, through mechanization A or B, errors against the truth at every step.
 #include "driftlab/simulate.h"
 
 #include <algorithm>
@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "driftlab/sensors.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab {
@@ -28,7 +29,23 @@ void Accumulate(const NavError& e, SimulationSummary* summary) {
 
 SimulationSummary RunErrorFreeSimulation(
     const SimulationSpec& spec, const std::function<void(const SimulationStep&)>& on_step) {
+  return RunSimulation(spec, nullptr, on_step);
+}
+
+SimulationSummary RunSimulation(const SimulationSpec& spec, const SensorRun* sensor,
+                                const std::function<void(const SimulationStep&)>& on_step) {
   TrajectoryGenerator generator(spec.motion, spec.rate_hz);  // validates motion and rate
+  // Two simulators of the same run: one for the increment stream (mechanization A) and one for
+  // the point-sample stream (mechanization B); each Apply advances its simulator by one output.
+  // Both draw the run's constants (turn-on bias, scale factor, misalignment) from the same
+  // streams, so those are identical; the processes are each a valid realisation, sample k using
+  // the deviates of index k and the increment over (t_k, t_k+1] those of index k.
+  std::optional<ImuErrorSimulator> imu_increments;  // constructors validate the model
+  std::optional<ImuErrorSimulator> imu_samples;
+  if (sensor != nullptr) {
+    imu_increments.emplace(sensor->model, sensor->seed, sensor->run_index, spec.rate_hz);
+    imu_samples.emplace(sensor->model, sensor->seed, sensor->run_index, spec.rate_hz);
+  }
   const NavEnvironment& env = generator.environment();
   const NavState truth0 = generator.initial_state();
   const double dt_s = generator.dt_s();
@@ -45,12 +62,19 @@ SimulationSummary RunErrorFreeSimulation(
           "at most the motion's duration (" + std::to_string(generator.duration_s()) + " s)");
     }
     seed000.emplace(dt_s, spec.seed000);
-    seed000->Update(generator.initial_sample());
+  }
+
+  // The sample at t = 0 is the first IMU output (the point-sample stream starts there; the
+  // increment stream starts with the interval (0, dt]).
+  const ImuIncrement zero_increment;
+  ImuSample measured_sample0 = generator.initial_sample();
+  if (imu_samples) imu_samples->Apply(generator.initial_sample(), &measured_sample0);
+  if (seed000) {
+    seed000->Update(measured_sample0);
     nav = seed000->ToNed(env, truth0);
   }
 
   SimulationSummary summary;
-  const ImuIncrement zero_increment;
   NavError error = ComputeNavError(env, nav, truth0);
   Accumulate(error, &summary);
   if (on_step) {
@@ -59,21 +83,32 @@ SimulationSummary RunErrorFreeSimulation(
     step.truth = &truth0;
     step.increment = &zero_increment;
     step.sample = &generator.initial_sample();
+    step.measured_increment = &zero_increment;
+    step.measured_sample = &measured_sample0;
     step.nav = &nav;
     step.error = &error;
     on_step(step);
   }
 
   TrajectorySample sample;
+  ImuIncrement measured_increment;
+  ImuSample measured_sample;
   while (generator.Next(&sample)) {
+    if (sensor != nullptr) {
+      imu_increments->Apply(sample.increment, &measured_increment);
+      imu_samples->Apply(sample.sample, &measured_sample);
+    } else {
+      measured_increment = sample.increment;
+      measured_sample = sample.sample;
+    }
     if (ned) {
-      ned->Update(sample.increment);
+      ned->Update(measured_increment);
       if (spec.ned.vertical == VerticalChannel::kTruthHeight) {
         ned->SetVertical(sample.truth.llh.h_m, sample.truth.v_eb_n.z());
       }
       nav = ned->state();
     } else {
-      seed000->Update(sample.sample);
+      seed000->Update(measured_sample);
       nav = seed000->ToNed(env, truth0);
     }
     error = ComputeNavError(env, nav, sample.truth);
@@ -84,6 +119,8 @@ SimulationSummary RunErrorFreeSimulation(
       step.truth = &sample.truth;
       step.increment = &sample.increment;
       step.sample = &sample.sample;
+      step.measured_increment = &measured_increment;
+      step.measured_sample = &measured_sample;
       step.nav = &nav;
       step.error = &error;
       on_step(step);

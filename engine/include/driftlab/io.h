@@ -22,6 +22,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <istream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -100,17 +101,20 @@ class GrovesProfileWriter : public CsvFile {
   void Write(const NavState& state);
 };
 
-// The four files of `driftlab simulate` in `dir`: truth.csv, imu.csv, nav.csv, errors.csv, one row
-// per output epoch (k = 0 carries the zero increment).
+// The files of `driftlab simulate` / `export` in `dir`: truth.csv, imu.csv (what the IMU outputs:
+// the measured data when the step has them, else the ideal data), nav.csv, errors.csv and, with
+// `ideal_imu`, imu_ideal.csv (the error-free data); one row per output epoch (k = 0 carries the
+// zero increment).
 class SimulationCsvWriters {
  public:
-  explicit SimulationCsvWriters(const std::filesystem::path& dir);
+  explicit SimulationCsvWriters(const std::filesystem::path& dir, bool ideal_imu = false);
   void Write(const SimulationStep& step);
   void Close();
 
  private:
   TruthCsvWriter truth_;
   ImuCsvWriter imu_;
+  std::optional<ImuCsvWriter> imu_ideal_;
   NavCsvWriter nav_;
   ErrorsCsvWriter errors_;
 };

@@ -7,6 +7,7 @@
 
 #include "driftlab/ins.h"
 #include "driftlab/nav_state.h"
+#include "driftlab/sensor_params.h"
 #include "driftlab/trajectory.h"
 
 namespace driftlab {
@@ -24,14 +25,25 @@ struct SimulationSpec {
   Seed000Options seed000;
 };
 
+// One seeded run of a sensor error model (sensors.h): the run's errors are a pure function of
+// (model, seed, run_index, rate).
+struct SensorRun {
+  ImuErrorModel model;
+  uint64_t seed = 1;
+  uint32_t run_index = 0;
+};
+
 // Everything known at one output step k (k = 0 is the initial epoch, increment zero).
 struct SimulationStep {
   int64_t k = 0;
   const NavState* truth = nullptr;
   const ImuIncrement* increment = nullptr;  // ideal increment over (t_{k-1}, t_k]
   const ImuSample* sample = nullptr;        // ideal point sample at t_k
-  const NavState* nav = nullptr;            // INS solution at t_k (NED)
-  const NavError* error = nullptr;          // nav - truth
+  // What the IMU outputs (= the ideal data without a sensor model); the mechanization uses these.
+  const ImuIncrement* measured_increment = nullptr;
+  const ImuSample* measured_sample = nullptr;
+  const NavState* nav = nullptr;    // INS solution at t_k (NED)
+  const NavError* error = nullptr;  // nav - truth
 };
 
 struct SimulationSummary {
@@ -47,8 +59,15 @@ struct SimulationSummary {
   double final_horizontal_position_m = 0.0;
 };
 
-// Runs the error-free simulation; `on_step` (optional) sees every step in order.
-// Throws SpecError for invalid specs.
+// Runs one simulation: ideal IMU data, through `sensor`'s error model when given (else used as
+// they are), through the mechanization, with errors against the truth at every step. The
+// navigation starts from the true initial state (mechanization A) or from its own static-period
+// alignment (mechanization B). `on_step` (optional) sees every step in order.
+// Throws SpecError for invalid specs (including the sensor model).
+SimulationSummary RunSimulation(const SimulationSpec& spec, const SensorRun* sensor,
+                                const std::function<void(const SimulationStep&)>& on_step);
+
+// RunSimulation without a sensor model.
 SimulationSummary RunErrorFreeSimulation(const SimulationSpec& spec,
                                          const std::function<void(const SimulationStep&)>& on_step);
 
