@@ -1,0 +1,69 @@
+// Monte-Carlo throughput (DESIGN.md "Speed by design", issue 4): IMU samples per second through
+// the full per-run pipeline (sensor error model "tactical" from presets.h with every term it has
+// on, mechanization A with coning/sculling, errors and exact sums at the epochs), at 1 and 2
+// worker threads. Build Release for numbers:
+//   cmake --build build-rel --target driftlab_bench_monte_carlo
+//   build-rel/bench/driftlab_bench_monte_carlo
+// Counters: samples_per_s (all threads) and samples_per_s_per_core = samples_per_s / threads.
+// The shared truth is generated once per iteration, as in a real job; its share is reported as
+// truth_fraction.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+#include "driftlab/monte_carlo.h"
+#include "driftlab/presets.h"
+
+namespace driftlab {
+namespace {
+
+// 600 s at 100 Hz: 60 s static, accelerate to 20 m/s, a 90-degree turn, cruise.
+MonteCarloSpec BenchJob(int threads, uint32_t runs) {
+  constexpr double kDeg = M_PI / 180.0;
+  MonteCarloSpec spec;
+  spec.simulation.motion.initial.llh = {45.0 * kDeg, 7.0 * kDeg, 300.0};
+  spec.simulation.motion.segments.push_back(StaticSegment{60.0});
+  AccelerateSegment acc;
+  acc.acceleration_m_per_s2 = 1.0;
+  acc.target_speed_m_per_s = 20.0;
+  spec.simulation.motion.segments.push_back(acc);
+  TurnSegment turn;
+  turn.rate_rad_per_s = 3.0 * kDeg;
+  turn.angle_rad = 90.0 * kDeg;
+  turn.transition_s = 2.0;
+  spec.simulation.motion.segments.push_back(turn);
+  spec.simulation.motion.segments.push_back(ConstantVelocitySegment{600.0 - 60.0 - 20.0 - 32.0});
+  spec.simulation.rate_hz = 100.0;
+  spec.sensor = FindImuPreset("tactical");
+  spec.runs = runs;
+  spec.epoch_every_samples = 100;
+  spec.initial_errors.attitude_rad = Eigen::Vector3d(1e-3, 1e-3, 1e-2);
+  spec.threads = threads;
+  return spec;
+}
+
+void BM_MonteCarloTactical(benchmark::State& state) {
+  const int threads = static_cast<int>(state.range(0));
+  const MonteCarloSpec spec = BenchJob(threads, static_cast<uint32_t>(8 * threads));
+  int64_t samples = 0;
+  double truth_s = 0.0, wall_s = 0.0;
+  for (auto _ : state) {
+    const MonteCarloStatistics stats = RunMonteCarlo(spec);
+    samples += stats.data().timings.samples_processed;
+    truth_s += stats.data().timings.truth_s;
+    wall_s += stats.data().timings.wall_s;
+    benchmark::DoNotOptimize(stats.data().epochs.data());
+  }
+  state.SetItemsProcessed(samples);
+  state.counters["samples_per_s"] =
+      benchmark::Counter(static_cast<double>(samples), benchmark::Counter::kIsRate);
+  state.counters["samples_per_s_per_core"] =
+      benchmark::Counter(static_cast<double>(samples) / threads, benchmark::Counter::kIsRate);
+  state.counters["truth_fraction"] = truth_s / wall_s;
+}
+BENCHMARK(BM_MonteCarloTactical)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace driftlab
+
+BENCHMARK_MAIN();

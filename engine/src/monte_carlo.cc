@@ -1,0 +1,682 @@
+// Monte-Carlo runner: validation, the shared truth, the per-run loop and the parallel reduction
+// (see monte_carlo.h).
+#include "driftlab/monte_carlo.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "driftlab/random.h"
+#include "driftlab/sensors.h"
+#include "driftlab/spec_error.h"
+
+namespace driftlab {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// Cancellation and progress are polled every kPollSamples samples of a run.
+constexpr int64_t kPollSamples = 1024;
+constexpr int64_t kProgressInterval_ns = 100'000'000;  // at most 10 progress calls per second
+
+std::string Num(double v) {
+  std::ostringstream os;
+  os.precision(17);
+  os << v;
+  return os.str();
+}
+
+std::string Indexed(const std::string& field, size_t i) {
+  return field + "[" + std::to_string(i) + "]";
+}
+
+double Seconds(Clock::time_point since) {
+  return std::chrono::duration<double>(Clock::now() - since).count();
+}
+
+void ValidateSigmas(const Eigen::Vector3d& v, const std::string& field, const std::string& unit) {
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(v[i]) || v[i] < 0.0) {
+      throw SpecError(Indexed(field, static_cast<size_t>(i)), Num(v[i]),
+                      "a finite 1-sigma >= 0 [" + unit + "]");
+    }
+  }
+}
+
+// A sample at which errors are reported: an epoch (per-epoch sums), a checkpoint (per-run values)
+// or both. `truth` is the truth state at sample k.
+struct Report {
+  int64_t k = 0;
+  int epoch = -1;
+  int checkpoint = -1;
+  NavState truth;
+};
+
+// What the runs share, read-only.
+struct SharedTruth {
+  NavEnvironment env;
+  double dt_s = 0.0;
+  double rate_hz = 0.0;
+  int64_t n = 0;           // output intervals; samples k = 0..n
+  int64_t start_step = 0;  // s0: sample at which navigation starts
+  NavState truth0;         // truth at t = 0
+  NavState truth_start;    // truth at s0
+  // Mechanization A: increments[k] covers (t_{k-1}, t_k], k = 1..n (index 0 unused).
+  std::vector<ImuIncrement> increments;
+  // Mechanization B: point samples k = 0..n.
+  std::vector<ImuSample> samples;
+  // Truth-height aiding: h and v_D at every sample.
+  std::vector<double> h_m, v_D_m_per_s;
+  std::vector<Report> reports;  // ascending k, all >= start_step
+};
+
+// Converts requested times into ascending sample indices in [first_k, n].
+std::vector<int64_t> SnapTimes(const std::vector<double>& times_s, const std::string& field,
+                               int64_t first_k, int64_t n, double dt_s) {
+  std::vector<int64_t> out;
+  const double t_min = static_cast<double>(first_k) * dt_s;
+  const double t_max = static_cast<double>(n) * dt_s;
+  const double slack = 0.5 * dt_s;
+  const std::string allowed = "[" + Num(t_min) + ", " + Num(t_max) +
+                              "] s (navigation start to trajectory end), strictly ascending";
+  for (size_t i = 0; i < times_s.size(); ++i) {
+    const double t = times_s[i];
+    if (!std::isfinite(t) || t < t_min - slack || t > t_max + slack) {
+      throw SpecError(Indexed(field, i), Num(t), allowed);
+    }
+    const int64_t k = std::clamp<int64_t>(std::llround(t / dt_s), first_k, n);
+    if (!out.empty() && k <= out.back()) {
+      throw SpecError(
+          Indexed(field, i), Num(t),
+          allowed + " after snapping to the IMU sample grid (dt = " + Num(dt_s) + " s)");
+    }
+    out.push_back(k);
+  }
+  return out;
+}
+
+// Validates the Monte-Carlo fields that do not need the trajectory.
+void ValidateSpec(const MonteCarloSpec& spec) {
+  if (spec.runs < 1 || spec.runs > kMaxMonteCarloRuns) {
+    throw SpecError("monte_carlo.runs", std::to_string(spec.runs),
+                    "[1, " + std::to_string(kMaxMonteCarloRuns) + "]");
+  }
+  if (spec.first_run >= spec.runs) {
+    throw SpecError("monte_carlo.first_run", std::to_string(spec.first_run),
+                    "[0, runs - 1] = [0, " + std::to_string(spec.runs - 1) + "]");
+  }
+  if (uint64_t{spec.first_run} + spec.run_count > spec.runs) {
+    throw SpecError("monte_carlo.run_count", std::to_string(spec.run_count),
+                    "first_run + run_count <= runs, i.e. <= " +
+                        std::to_string(spec.runs - spec.first_run) + " (0 = all from first_run)");
+  }
+  if (spec.threads < 0 || spec.threads > kMaxMonteCarloThreads) {
+    throw SpecError("monte_carlo.threads", std::to_string(spec.threads),
+                    "[0, " + std::to_string(kMaxMonteCarloThreads) + "] (0 = all cores)");
+  }
+  ValidateSigmas(spec.initial_errors.position_ned_m, "monte_carlo.initial_errors.position_ned_m",
+                 "m");
+  ValidateSigmas(spec.initial_errors.velocity_ned_m_per_s,
+                 "monte_carlo.initial_errors.velocity_ned_m_per_s", "m/s");
+  ValidateSigmas(spec.initial_errors.attitude_rad, "monte_carlo.initial_errors.attitude_rad",
+                 "rad");
+  if (spec.epoch_times_s.empty()) {
+    if (spec.epoch_every_samples < 1) {
+      throw SpecError("monte_carlo.epoch_every_samples", std::to_string(spec.epoch_every_samples),
+                      ">= 1 samples (or give epoch_times_s)");
+    }
+  } else if (spec.epoch_every_samples != 0) {
+    throw SpecError("monte_carlo.epoch_every_samples", std::to_string(spec.epoch_every_samples),
+                    "0 when epoch_times_s is given (one of the two)");
+  }
+  if (spec.checkpoint_times_s.size() + 1 > kMaxMonteCarloCheckpoints) {
+    throw SpecError("monte_carlo.checkpoint_times_s",
+                    std::to_string(spec.checkpoint_times_s.size()) + " times",
+                    "at most " + std::to_string(kMaxMonteCarloCheckpoints - 1));
+  }
+  const bool seed000 = spec.simulation.mechanization == MechanizationKind::kSeed000;
+  if (seed000) {
+    if (spec.initialization != InitializationKind::kTruthPlusErrors) {
+      throw SpecError("monte_carlo.initialization", "static_alignment",
+                      "truth_plus_errors with mechanization seed000 (it initialises itself from "
+                      "its static period)");
+    }
+    const InitialErrorSigmas& e = spec.initial_errors;
+    if (!e.position_ned_m.isZero(0.0) || !e.velocity_ned_m_per_s.isZero(0.0) ||
+        !e.attitude_rad.isZero(0.0)) {
+      throw SpecError("monte_carlo.initial_errors", "non-zero",
+                      "zero with mechanization seed000 (it initialises itself from its static "
+                      "period)");
+    }
+  }
+  if (!seed000 && spec.initialization == InitializationKind::kStaticAlignment) {
+    const AlignmentOptions& a = spec.alignment;
+    if (!std::isfinite(a.duration_s) || a.duration_s <= 0.0) {
+      throw SpecError("monte_carlo.alignment.duration_s", Num(a.duration_s),
+                      "a finite duration > 0 [s]");
+    }
+    if (a.heading_sigma_rad &&
+        (!std::isfinite(*a.heading_sigma_rad) || *a.heading_sigma_rad <= 0.0)) {
+      throw SpecError("monte_carlo.alignment.heading_sigma_rad", Num(*a.heading_sigma_rad),
+                      "a finite 1-sigma > 0 [rad], or absent (always gyrocompass)");
+    }
+    if (!spec.initial_errors.attitude_rad.isZero(0.0)) {
+      throw SpecError("monte_carlo.initial_errors.attitude_rad", "non-zero",
+                      "zero with initialization static_alignment (the attitude comes from the "
+                      "alignment)");
+    }
+  }
+}
+
+// Generates the truth once and keeps what the runs need.
+SharedTruth BuildSharedTruth(const MonteCarloSpec& spec) {
+  TrajectoryGenerator generator(spec.simulation.motion, spec.simulation.rate_hz);
+  SharedTruth s;
+  s.env = generator.environment();
+  s.dt_s = generator.dt_s();
+  s.rate_hz = generator.rate_hz();
+  s.n = generator.num_steps();
+  s.truth0 = generator.initial_state();
+  const bool seed000 = spec.simulation.mechanization == MechanizationKind::kSeed000;
+
+  // Navigation start.
+  if (seed000) {
+    const double T = spec.simulation.seed000.static_period_s;
+    if (T > generator.duration_s()) {
+      throw SpecError("navigation.seed000.static_period_s", Num(T),
+                      "at most the motion's duration (" + Num(generator.duration_s()) + " s)");
+    }
+    s.start_step = std::llround(T / s.dt_s);  // Seed000Options: N = round(T / dt)
+  } else if (spec.initialization == InitializationKind::kStaticAlignment) {
+    const double T = spec.alignment.duration_s;
+    s.start_step = std::llround(T / s.dt_s);
+    if (s.start_step < 1 || s.start_step > s.n) {
+      throw SpecError("monte_carlo.alignment.duration_s", Num(T),
+                      "[" + Num(s.dt_s) + ", " + Num(generator.duration_s()) +
+                          "] s (at least one IMU sample, at most the trajectory)");
+    }
+    // Static at every sample of the window and at every kink inside it.
+    bool is_static = true;
+    for (int64_t k = 0; k <= s.start_step && is_static; ++k) {
+      is_static = generator.IsStaticAt(static_cast<double>(k) * s.dt_s);
+    }
+    for (double t : generator.breakpoints_s()) {
+      if (t <= static_cast<double>(s.start_step) * s.dt_s) is_static &= generator.IsStaticAt(t);
+    }
+    if (!is_static) {
+      throw SpecError("monte_carlo.alignment.duration_s", Num(T),
+                      "a window over which the trajectory is static (the vehicle moves before " +
+                          Num(static_cast<double>(s.start_step) * s.dt_s) + " s)");
+    }
+    if (!spec.alignment.heading_sigma_rad && s.env.model() == EarthModel::kFlat) {
+      throw SpecError("monte_carlo.alignment.heading_sigma_rad", "",
+                      "a 1-sigma > 0 [rad] with the flat Earth model (no Earth rotation to "
+                      "gyrocompass on)");
+    }
+  }
+
+  // Epochs and checkpoints as sample indices.
+  std::vector<int64_t> epoch_k;
+  if (spec.epoch_times_s.empty()) {
+    for (int64_t k = s.start_step; k <= s.n; k += spec.epoch_every_samples) {
+      epoch_k.push_back(k);
+      if (epoch_k.size() > kMaxMonteCarloEpochs) break;
+    }
+    if (epoch_k.back() != s.n) epoch_k.push_back(s.n);
+    if (epoch_k.size() > kMaxMonteCarloEpochs) {
+      throw SpecError("monte_carlo.epoch_every_samples", std::to_string(spec.epoch_every_samples),
+                      "at least " +
+                          std::to_string((s.n - s.start_step) / (kMaxMonteCarloEpochs - 1) + 1) +
+                          " (at most " + std::to_string(kMaxMonteCarloEpochs) + " epochs)");
+    }
+  } else {
+    if (spec.epoch_times_s.size() > kMaxMonteCarloEpochs) {
+      throw SpecError("monte_carlo.epoch_times_s", std::to_string(spec.epoch_times_s.size()),
+                      "at most " + std::to_string(kMaxMonteCarloEpochs) + " epochs");
+    }
+    epoch_k = SnapTimes(spec.epoch_times_s, "monte_carlo.epoch_times_s", s.start_step, s.n, s.dt_s);
+  }
+  std::vector<int64_t> checkpoint_k = SnapTimes(
+      spec.checkpoint_times_s, "monte_carlo.checkpoint_times_s", s.start_step, s.n, s.dt_s);
+  if (checkpoint_k.empty() || checkpoint_k.back() != s.n) checkpoint_k.push_back(s.n);
+
+  // Merge both ascending lists into the report list.
+  size_t i = 0, j = 0;
+  while (i < epoch_k.size() || j < checkpoint_k.size()) {
+    Report r;
+    const int64_t ke = i < epoch_k.size() ? epoch_k[i] : std::numeric_limits<int64_t>::max();
+    const int64_t kc =
+        j < checkpoint_k.size() ? checkpoint_k[j] : std::numeric_limits<int64_t>::max();
+    r.k = std::min(ke, kc);
+    if (ke == r.k) r.epoch = static_cast<int>(i++);
+    if (kc == r.k) r.checkpoint = static_cast<int>(j++);
+    s.reports.push_back(r);
+  }
+
+  // Stream the trajectory once.
+  const bool truth_height =
+      !seed000 && spec.simulation.ned.vertical == VerticalChannel::kTruthHeight;
+  if (seed000) {
+    s.samples.resize(static_cast<size_t>(s.n) + 1);
+    s.samples[0] = generator.initial_sample();
+  } else {
+    s.increments.resize(static_cast<size_t>(s.n) + 1);
+  }
+  if (truth_height) {
+    s.h_m.resize(static_cast<size_t>(s.n) + 1);
+    s.v_D_m_per_s.resize(static_cast<size_t>(s.n) + 1);
+    s.h_m[0] = s.truth0.llh.h_m;
+    s.v_D_m_per_s[0] = s.truth0.v_eb_n.z();
+  }
+  size_t next_report = 0;
+  auto keep_truth = [&](int64_t k, const NavState& truth) {
+    if (k == s.start_step) s.truth_start = truth;
+    while (next_report < s.reports.size() && s.reports[next_report].k == k) {
+      s.reports[next_report++].truth = truth;
+    }
+  };
+  keep_truth(0, s.truth0);
+  TrajectorySample sample;
+  while (generator.Next(&sample)) {
+    const int64_t k = generator.step();
+    const size_t uk = static_cast<size_t>(k);
+    if (seed000) {
+      s.samples[uk] = sample.sample;
+    } else {
+      s.increments[uk] = sample.increment;
+    }
+    if (truth_height) {
+      s.h_m[uk] = sample.truth.llh.h_m;
+      s.v_D_m_per_s[uk] = sample.truth.v_eb_n.z();
+    }
+    keep_truth(k, sample.truth);
+  }
+  return s;
+}
+
+// Shared state of the workers: progress counters, cancellation, progress-callback throttling.
+class Monitor {
+ public:
+  Monitor(const std::function<void(const MonteCarloProgress&)>& progress,
+          const std::atomic<bool>* cancel, uint32_t runs_total, int64_t samples_total,
+          Clock::time_point start)
+      : progress_(progress),
+        cancel_(cancel),
+        runs_total_(runs_total),
+        samples_total_(samples_total),
+        start_(start) {}
+
+  // Called by a run every kPollSamples samples; true = stop.
+  bool Poll(int64_t samples) {
+    samples_done_.fetch_add(samples, std::memory_order_relaxed);
+    MaybeReport();
+    return Stopped();
+  }
+  bool Stopped() {
+    if (cancel_ != nullptr && cancel_->load(std::memory_order_relaxed)) {
+      stopped_.store(true, std::memory_order_relaxed);
+    }
+    return stopped_.load(std::memory_order_relaxed);
+  }
+  void RunDone(int64_t samples) {
+    samples_done_.fetch_add(samples, std::memory_order_relaxed);
+    runs_done_.fetch_add(1, std::memory_order_relaxed);
+  }
+  int64_t samples_done() const { return samples_done_.load(); }
+  void ReportFinal() {
+    if (!progress_) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    progress_(Snapshot());
+  }
+
+ private:
+  MonteCarloProgress Snapshot() const {
+    MonteCarloProgress p;
+    p.runs_done = runs_done_.load(std::memory_order_relaxed);
+    p.runs_total = runs_total_;
+    p.samples_done = samples_done_.load(std::memory_order_relaxed);
+    p.samples_total = samples_total_;
+    p.elapsed_s = Seconds(start_);
+    return p;
+  }
+  void MaybeReport() {
+    if (!progress_) return;
+    const int64_t now_ns =
+        std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - start_).count();
+    if (now_ns < next_report_ns_.load(std::memory_order_relaxed)) return;
+    std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
+    if (!lock.owns_lock() || now_ns < next_report_ns_.load(std::memory_order_relaxed)) return;
+    next_report_ns_.store(now_ns + kProgressInterval_ns, std::memory_order_relaxed);
+    progress_(Snapshot());
+  }
+
+  const std::function<void(const MonteCarloProgress&)>& progress_;
+  const std::atomic<bool>* cancel_;
+  const uint32_t runs_total_;
+  const int64_t samples_total_;
+  const Clock::time_point start_;
+  std::atomic<int64_t> samples_done_{0};
+  std::atomic<uint32_t> runs_done_{0};
+  std::atomic<bool> stopped_{false};
+  std::atomic<int64_t> next_report_ns_{0};
+  std::mutex mutex_;
+};
+
+// Per-thread accumulator of the epoch sums.
+using EpochAccumulator = std::vector<EpochSums>;
+
+// Where one run's reported errors go.
+struct RunSink {
+  EpochAccumulator* epochs = nullptr;
+  // checkpoint_values[c][run - first_run]
+  std::vector<std::vector<ErrorComponentValues>>* checkpoint_values = nullptr;
+  uint32_t slot = 0;
+
+  void Record(const Report& r, const NavError& error) const {
+    const ErrorComponentValues v = ErrorComponentsOf(error);
+    if (r.epoch >= 0) {
+      EpochSums& sums = (*epochs)[static_cast<size_t>(r.epoch)];
+      for (int c = 0; c < kNumErrorComponents; ++c) {
+        sums.sum[c].Add(v[c]);
+        sums.sum_squares[c].AddSquare(v[c]);
+      }
+    }
+    if (r.checkpoint >= 0) (*checkpoint_values)[static_cast<size_t>(r.checkpoint)][slot] = v;
+  }
+};
+
+Eigen::Vector3d InitialErrorDraw(uint64_t seed, uint32_t run, uint8_t component,
+                                 const Eigen::Vector3d& sigma) {
+  Eigen::Vector3d out = Eigen::Vector3d::Zero();
+  for (int axis = 0; axis < 3; ++axis) {
+    if (sigma[axis] == 0.0) continue;
+    const RandomStream stream(seed, run,
+                              StreamKey{SensorId::kInitialConditions, static_cast<uint8_t>(axis),
+                                        ErrorTerm::kInitialError, component});
+    out[axis] = sigma[axis] * stream.Gaussian(0);
+  }
+  return out;
+}
+
+// Truth position and velocity at navigation start plus the run's initial errors; attitude set by
+// the caller.
+NavState PerturbedStart(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run) {
+  NavState init = s.truth_start;
+  const Eigen::Vector3d dr =
+      InitialErrorDraw(spec.seed, run, 0, spec.initial_errors.position_ned_m);
+  const Eigen::Vector3d dv =
+      InitialErrorDraw(spec.seed, run, 1, spec.initial_errors.velocity_ned_m_per_s);
+  // Curvilinear position offset with the environment's radii (as PositionErrorNed measures it).
+  const double L = init.llh.lat_rad;
+  const double h = init.llh.h_m;
+  init.llh.lat_rad += dr.x() / (s.env.MeridianRadiusAt(L) + h);
+  init.llh.lon_rad += dr.y() / ((s.env.TransverseRadiusAt(L) + h) * std::cos(L));
+  init.llh.h_m -= dr.z();
+  init.v_eb_n += dv;
+  return init;
+}
+
+// Runs one run with mechanization A. Returns false if stopped early.
+bool RunNed(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, bool gyrocompass,
+            const RunSink& sink, Monitor* monitor, int64_t* samples) {
+  std::optional<ImuErrorSimulator> sim;
+  if (spec.sensor) sim.emplace(*spec.sensor, spec.seed, run, s.rate_hz);
+  const bool truth_height = spec.simulation.ned.vertical == VerticalChannel::kTruthHeight;
+  ImuIncrement measured;
+  auto measure = [&](int64_t k) {
+    const ImuIncrement& ideal = s.increments[static_cast<size_t>(k)];
+    if (sim) {
+      sim->Apply(ideal, &measured);
+    } else {
+      measured = ideal;
+    }
+  };
+  int64_t polled = 0;
+  auto poll = [&](int64_t k) {
+    if ((k & (kPollSamples - 1)) != 0) return false;
+    const int64_t d = k - polled;
+    polled = k;
+    return monitor->Poll(d);
+  };
+
+  // Alignment window: accumulate the measured increments.
+  Eigen::Vector3d sum_dtheta = Eigen::Vector3d::Zero(), sum_dv = Eigen::Vector3d::Zero();
+  for (int64_t k = 1; k <= s.start_step; ++k) {
+    measure(k);
+    sum_dtheta += measured.delta_theta_ib_b;
+    sum_dv += measured.delta_v_ib_b;
+    if (poll(k)) {
+      *samples = k;
+      return false;
+    }
+  }
+
+  NavState init = PerturbedStart(s, spec, run);
+  if (spec.initialization == InitializationKind::kStaticAlignment) {
+    const double T = static_cast<double>(s.start_step) * s.dt_s;
+    const Eigen::Vector3d f = sum_dv / T;
+    const Eigen::Vector3d w = sum_dtheta / T;
+    EulerAngles e;
+    e.roll_rad = std::atan2(-f.y(), -f.z());
+    e.pitch_rad = std::atan(f.x() / std::hypot(f.y(), f.z()));
+    if (gyrocompass) {
+      const double sr = std::sin(e.roll_rad), cr = std::cos(e.roll_rad);
+      const double sp = std::sin(e.pitch_rad), cp = std::cos(e.pitch_rad);
+      e.yaw_rad = std::atan2(-w.y() * cr + w.z() * sr, w.x() * cp + (w.y() * sr + w.z() * cr) * sp);
+    } else {
+      const Eigen::Vector3d heading_sigma(0.0, 0.0, *spec.alignment.heading_sigma_rad);
+      e.yaw_rad = WrapPi(s.truth_start.euler().yaw_rad +
+                         InitialErrorDraw(spec.seed, run, 3, heading_sigma).z());
+    }
+    init.q_b_n = Quaterniond(EulerToDcm(e));
+  } else {
+    EulerAngles e = s.truth_start.euler();
+    const Eigen::Vector3d da =
+        InitialErrorDraw(spec.seed, run, 2, spec.initial_errors.attitude_rad);
+    e.roll_rad += da.x();
+    e.pitch_rad += da.y();
+    e.yaw_rad += da.z();
+    init.q_b_n = Quaterniond(EulerToDcm(e));
+  }
+
+  NedMechanization ned(s.env, init, s.dt_s, spec.simulation.ned);
+  size_t next = 0;
+  const size_t n_reports = s.reports.size();
+  if (s.reports[0].k == s.start_step) {
+    sink.Record(s.reports[0], ComputeNavError(s.env, ned.state(), s.reports[0].truth));
+    next = 1;
+  }
+  for (int64_t k = s.start_step + 1; k <= s.n; ++k) {
+    measure(k);
+    ned.Update(measured);
+    if (truth_height) {
+      ned.SetVertical(s.h_m[static_cast<size_t>(k)], s.v_D_m_per_s[static_cast<size_t>(k)]);
+    }
+    if (next < n_reports && s.reports[next].k == k) {
+      sink.Record(s.reports[next], ComputeNavError(s.env, ned.state(), s.reports[next].truth));
+      ++next;
+    }
+    if (poll(k)) {
+      *samples = k;
+      return false;
+    }
+  }
+  *samples = s.n - polled;
+  return true;
+}
+
+// Runs one run with mechanization B. Returns false if stopped early.
+bool RunSeed000(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, const RunSink& sink,
+                Monitor* monitor, int64_t* samples) {
+  std::optional<ImuErrorSimulator> sim;
+  if (spec.sensor) sim.emplace(*spec.sensor, spec.seed, run, s.rate_hz);
+  ImuSample measured;
+  Seed000Mechanization mech(s.dt_s, spec.simulation.seed000);
+  size_t next = 0;
+  const size_t n_reports = s.reports.size();
+  int64_t polled = 0;
+  for (int64_t k = 0; k <= s.n; ++k) {
+    const ImuSample& ideal = s.samples[static_cast<size_t>(k)];
+    if (sim) {
+      sim->Apply(ideal, &measured);
+    } else {
+      measured = ideal;
+    }
+    mech.Update(measured);
+    if (next < n_reports && s.reports[next].k == k) {
+      const NavState nav = mech.ToNed(s.env, s.truth0);
+      sink.Record(s.reports[next], ComputeNavError(s.env, nav, s.reports[next].truth));
+      ++next;
+    }
+    if (k > 0 && (k & (kPollSamples - 1)) == 0) {
+      const int64_t d = k - polled;
+      polled = k;
+      if (monitor->Poll(d)) {
+        *samples = 0;
+        return false;
+      }
+    }
+  }
+  *samples = s.n + 1 - polled;
+  return true;
+}
+
+}  // namespace
+
+double PredictedGyrocompassHeadingSigma(const TriadErrorParams& gyro, double L_b, double duration_s,
+                                        double omega_ie_rad_per_s) {
+  const double horizontal_rate = omega_ie_rad_per_s * std::cos(L_b);
+  if (!(std::abs(horizontal_rate) > 0.0)) return std::numeric_limits<double>::infinity();
+  // 0.664 = sqrt(2 ln 2 / pi), the flicker floor of the Allan deviation (sensor_params.h).
+  const double flicker = std::sqrt(2.0 * std::log(2.0) / M_PI) * gyro.bias_flicker.bias_instability;
+  const double fixed = gyro.fixed_bias.cwiseAbs().maxCoeff();
+  const double T = duration_s;
+  const double bias2 = fixed * fixed + gyro.turn_on_bias_sigma * gyro.turn_on_bias_sigma +
+                       gyro.bias_gauss_markov.sigma * gyro.bias_gauss_markov.sigma +
+                       flicker * flicker + gyro.random_walk * gyro.random_walk * T / 3.0;
+  const double white2 = gyro.white_noise_density * gyro.white_noise_density / T;
+  return std::sqrt(bias2 + white2) / std::abs(horizontal_rate);
+}
+
+MonteCarloStatistics RunMonteCarlo(const MonteCarloSpec& spec,
+                                   const std::function<void(const MonteCarloProgress&)>& progress,
+                                   const std::atomic<bool>* cancel) {
+  const Clock::time_point start = Clock::now();
+  ValidateSpec(spec);
+  if (spec.sensor) ValidateImuErrorModel(*spec.sensor, "sensor");
+  const uint32_t run_count = spec.run_count == 0 ? spec.runs - spec.first_run : spec.run_count;
+
+  const SharedTruth truth = BuildSharedTruth(spec);
+  const double truth_s = Seconds(start);
+  const bool seed000 = spec.simulation.mechanization == MechanizationKind::kSeed000;
+
+  // Gyrocompass or external heading: one decision per job (it depends on the model only).
+  bool gyrocompass = true;
+  if (!seed000 && spec.initialization == InitializationKind::kStaticAlignment &&
+      spec.alignment.heading_sigma_rad) {
+    const double omega_ie =
+        truth.env.model() == EarthModel::kFlat ? 0.0 : kWgs84EarthRate_rad_per_s;
+    const double predicted =
+        spec.sensor
+            ? PredictedGyrocompassHeadingSigma(spec.sensor->gyro, truth.truth_start.llh.lat_rad,
+                                               spec.alignment.duration_s, omega_ie)
+            : (omega_ie > 0.0 ? 0.0 : std::numeric_limits<double>::infinity());
+    gyrocompass = predicted < *spec.alignment.heading_sigma_rad;
+  }
+
+  // Output buffers: per-run checkpoint values (each run writes its own slot), per-thread sums.
+  size_t n_epochs = 0, n_checkpoints = 0;
+  for (const Report& r : truth.reports) {
+    if (r.epoch >= 0) ++n_epochs;
+    if (r.checkpoint >= 0) ++n_checkpoints;
+  }
+  if (uint64_t{run_count} * n_checkpoints > uint64_t{kMaxMonteCarloRuns} * 10) {
+    throw SpecError("monte_carlo.checkpoint_times_s",
+                    std::to_string(n_checkpoints) + " checkpoints",
+                    "runs x checkpoints <= " + std::to_string(uint64_t{kMaxMonteCarloRuns} * 10));
+  }
+  std::vector<std::vector<ErrorComponentValues>> checkpoint_values(
+      n_checkpoints, std::vector<ErrorComponentValues>(run_count));
+  const EpochAccumulator exemplar(n_epochs);
+  tbb::enumerable_thread_specific<EpochAccumulator> accumulators(exemplar);
+
+  const int64_t samples_per_run = seed000 ? truth.n + 1 : truth.n;
+  Monitor monitor(progress, cancel, run_count, samples_per_run * int64_t{run_count}, start);
+  const int threads = spec.threads > 0 ? spec.threads : tbb::info::default_concurrency();
+  tbb::task_arena arena(threads);
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, run_count, 1),
+                      [&](const tbb::blocked_range<uint32_t>& range) {
+                        RunSink sink;
+                        sink.epochs = &accumulators.local();
+                        sink.checkpoint_values = &checkpoint_values;
+                        for (uint32_t slot = range.begin(); slot != range.end(); ++slot) {
+                          if (monitor.Stopped()) return;
+                          sink.slot = slot;
+                          const uint32_t run = spec.first_run + slot;
+                          int64_t samples = 0;
+                          const bool done =
+                              seed000
+                                  ? RunSeed000(truth, spec, run, sink, &monitor, &samples)
+                                  : RunNed(truth, spec, run, gyrocompass, sink, &monitor, &samples);
+                          if (!done) return;
+                          monitor.RunDone(samples);
+                        }
+                      });
+  });
+
+  MonteCarloStatisticsData data;
+  data.seed = spec.seed;
+  data.job_runs = spec.runs;
+  data.timings.truth_s = truth_s;
+  data.timings.threads = threads;
+  if (monitor.Stopped()) {
+    data.cancelled = true;
+    data.timings.samples_processed = monitor.samples_done();
+    data.timings.wall_s = Seconds(start);
+    return MonteCarloStatistics(std::move(data));
+  }
+  monitor.ReportFinal();
+
+  data.runs.push_back(RunRange{spec.first_run, spec.first_run + run_count});
+  data.epochs.resize(n_epochs);
+  for (const EpochAccumulator& local : accumulators) {
+    for (size_t e = 0; e < n_epochs; ++e) {
+      for (int c = 0; c < kNumErrorComponents; ++c) {
+        data.epochs[e].sum[c].Merge(local[e].sum[c]);
+        data.epochs[e].sum_squares[c].Merge(local[e].sum_squares[c]);
+      }
+    }
+  }
+  size_t c = 0;
+  for (const Report& r : truth.reports) {
+    if (r.epoch >= 0) data.epoch_times_s.push_back(static_cast<double>(r.k) * truth.dt_s);
+    if (r.checkpoint >= 0) {
+      CheckpointValues cp;
+      cp.t_s = static_cast<double>(r.k) * truth.dt_s;
+      cp.run_index.resize(run_count);
+      for (uint32_t i = 0; i < run_count; ++i) cp.run_index[i] = spec.first_run + i;
+      cp.values = std::move(checkpoint_values[c++]);
+      data.checkpoints.push_back(std::move(cp));
+    }
+  }
+  data.timings.samples_processed = monitor.samples_done();
+  data.timings.wall_s = Seconds(start);
+  return MonteCarloStatistics(std::move(data));
+}
+
+}  // namespace driftlab
