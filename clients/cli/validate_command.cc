@@ -7,8 +7,7 @@
 
 #include "commands.h"
 #include "driftlab/jobspec/job_file.h"
-#include "driftlab/jobspec/sensor_model.h"
-#include "driftlab/jobspec/translate.h"
+#include "driftlab/jobspec/monte_carlo_job.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::cli {
@@ -17,8 +16,7 @@ namespace {
 int RunValidate(const std::string& job_path) {
   try {
     const jobspec::JobFile file = jobspec::LoadJobFile(job_path);
-    jobspec::ValidateJob(file);
-    jobspec::ToImuErrorModel(file.job);
+    jobspec::ToMonteCarloSpec(file, {});  // motion, navigation, sensor and monte_carlo
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;

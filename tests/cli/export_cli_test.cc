@@ -113,7 +113,7 @@ TEST(Export, SimulateWritesTheSameMeasuredDataAsExport) {
 TEST(Export, AJobWithoutASensorModelIsRefused) {
   Scratch scratch;
   const Result r = RunDriftlab(
-      {"export", (kExamples / "car_drive.json").string(), "--out", (scratch.dir() / "x").string()},
+      {"export", (kExamples / "seed002_straight.json").string(), "--out", (scratch.dir() / "x").string()},
       scratch);
   EXPECT_EQ(r.exit_status, 2);
   EXPECT_NE(r.err.find("error: sensor: (absent) is not allowed"), std::string::npos) << r.err;

@@ -1,0 +1,55 @@
+// `driftlab report RESULT --out REPORT.html`: renders a result file as a self-contained HTML
+// report (html_report.h). Exit 0, 2 for a bad result file, 1 when the report cannot be written.
+#include <fmt/format.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include "commands.h"
+#include "driftlab/jobspec/html_report.h"
+#include "driftlab/jobspec/result_file.h"
+#include "driftlab/spec_error.h"
+
+namespace driftlab::cli {
+namespace {
+
+struct ReportOptions {
+  std::string result_path;
+  std::string out_path;
+};
+
+int RunReport(const ReportOptions& options) {
+  std::string html;
+  try {
+    html = jobspec::RenderHtmlReport(jobspec::ReadJobResult(options.result_path));
+  } catch (const SpecError& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return kExitBadJob;
+  }
+  std::ofstream out(options.out_path, std::ios::binary | std::ios::trunc);
+  if (out) out << html;
+  if (out) out.close();
+  if (!out) {
+    fmt::print(stderr, "error: {}: cannot write: {}\n", options.out_path, std::strerror(errno));
+    return kExitFailure;
+  }
+  fmt::print("wrote {} ({} bytes)\n", options.out_path, html.size());
+  return kExitOk;
+}
+
+const RegisterCommand kReport("report", [](CLI::App& app) -> std::function<int()> {
+  auto options = std::make_shared<ReportOptions>();
+  CLI::App* command =
+      app.add_subcommand("report", "Render a result file as a self-contained HTML report");
+  command->add_option("result", options->result_path, "Result file (JSON from `driftlab run`)")
+      ->required();
+  command->add_option("--out,-o", options->out_path, "HTML file to write")->required();
+  return [options] { return RunReport(*options); };
+});
+
+}  // namespace
+}  // namespace driftlab::cli
