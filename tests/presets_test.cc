@@ -343,5 +343,54 @@ TEST(SeedPresets, Seed003GyroTurnOnBiasFollowsFromTheNullSpreadAndTurntableSensi
   ExpectRelNear(m.accel.range, 3.0 * kG, "ADXL330 range");
 }
 
+// ---- Bosch BMI088 ------------------------------------------------------------------------------
+// Each figure below is the datasheet quantity as written (value + unit), converted by the units
+// module (units.h ToSi) and compared with the catalogue at kRelTol (exact conversions, rounding
+// only). Source (see the preset's description): BMI088 datasheet BST-BMI088-DS001 as quoted by
+// driver notes citing it (noise 0.014 (deg/s)/sqrt(Hz), 160 ug/sqrt(Hz); offsets +-1 deg/s,
+// +-20 mg; ranges +-2000 deg/s, +-24 g).
+struct DatasheetFigure {
+  const char* preset;
+  double value_si;
+  double value;
+  const char* unit;
+  Dimension dimension;
+};
+
+TEST(DatasheetPresets, Bmi088MatchesItsDatasheetFiguresThroughTheUnitsModule) {
+  const ImuErrorModel& bmi = FindImuPreset("bmi088");
+  const DatasheetFigure figures[] = {
+      {"bmi088", bmi.gyro.white_noise_density, 0.014, "(deg/s)/sqrt(Hz)", dims::kAngleRandomWalk},
+      {"bmi088", bmi.accel.white_noise_density, 160.0, "ug/sqrt(Hz)", dims::kVelocityRandomWalk},
+      {"bmi088", bmi.gyro.turn_on_bias_sigma, 1.0, "deg/s", dims::kAngularRate},
+      {"bmi088", bmi.accel.turn_on_bias_sigma, 20.0, "mg", dims::kAcceleration},
+      {"bmi088", bmi.gyro.range, 2000.0, "deg/s", dims::kAngularRate},
+      {"bmi088", bmi.accel.range, 24.0, "g", dims::kAcceleration},
+  };
+  for (const DatasheetFigure& f : figures) {
+    ExpectRelNear(f.value_si, ToSi(f.value, f.unit, f.dimension),
+                  std::string(f.preset) + " " + std::to_string(f.value) + " " + f.unit);
+  }
+}
+
+TEST(DatasheetPresets, RateNoiseDensityRoundTripsToArwBySeed001Equivalence) {
+  // Seed 001: 1 (deg/s)/sqrt(Hz) = 60 deg/sqrt(h), exactly. BMI088 0.014 -> 0.84 deg/sqrt(h).
+  // Printed with 6 significant digits by the units module and parsed back, the value must survive
+  // (relative rounding of the printed text < 5e-7).
+  const double n_si = FindImuPreset("bmi088").gyro.white_noise_density;
+  const std::string text = FormatQuantity(n_si, "deg/sqrt(h)", 6);
+  EXPECT_EQ(text,
+            FormatQuantity(ToSi(0.84, "deg/sqrt(h)", dims::kAngleRandomWalk), "deg/sqrt(h)", 6));
+  const Quantity back = ParseQuantity(text, dims::kAngleRandomWalk, "arw");
+  EXPECT_NEAR(back.value, 0.84, 5e-7 * 0.84);
+  EXPECT_NEAR(back.value_si, n_si, 5e-7 * n_si);
+}
+
+TEST(DatasheetPresets, Bmi088ListsItsAssumptions) {
+  const std::string& d = FindImuPreset("bmi088").description;
+  EXPECT_NE(d.find("BST-BMI088-DS001"), std::string::npos);
+  EXPECT_NE(d.find("Assumed"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace driftlab
