@@ -31,6 +31,7 @@
 #include <string_view>
 #include <vector>
 
+#include "allan_fit.h"
 #include "commands.h"
 #include "driftlab/allan.h"
 #include "driftlab/spec_error.h"
@@ -53,6 +54,9 @@ struct AllanCliOptions {
   std::string unit;
   std::string out_path;
   int points_per_octave = 1;
+  // --fit: the noise-model fit (allan_fit.h); --out then names the model file.
+  bool fit = false;
+  AllanFitOptions fit_options;
 };
 
 // Display units for one kind of signal.
@@ -473,8 +477,39 @@ const RegisterCommand kAllan("allan", [](CLI::App& app) -> std::function<int()> 
                       "ug; rad, deg, m/s for increments); default: from the column name suffix");
   command->add_option("--points-per-octave", options->points_per_octave,
                       "Tau grid density (1 = octave grid, up to 64)");
-  command->add_option("--out", options->out_path, "Write every point and the read-off as JSON");
-  return [options] { return RunAllan(*options); };
+  command->add_option("--out", options->out_path,
+                      "Write every point and the read-off as JSON (with --fit: the fitted model "
+                      "as a job-schema sensor fragment {\"sensor\": {...}})");
+  command->add_flag("--fit", options->fit,
+                    "Fit the IEEE Std 952 noise terms (white noise, bias instability, random "
+                    "walk, quantization, rate ramp) with Ceres, weighted by each tau's confidence");
+  command->add_option("--datasheet", options->fit_options.datasheet_path,
+                      "With --fit: a datasheet summary to compare with side by side");
+  command
+      ->add_option("--bias-model", options->fit_options.bias_model,
+                   "With --fit: flicker, gauss-markov or none")
+      ->capture_default_str();
+  command->add_option("--flicker-tau-min", options->fit_options.flicker_tau_min_s,
+                      "With --fit: flicker band start [s] (0 = first tau)");
+  command->add_option("--flicker-tau-max", options->fit_options.flicker_tau_max_s,
+                      "With --fit: flicker band end [s] (0 = last tau)");
+  return [options] {
+    if (!options->fit) return RunAllan(*options);
+    AllanFitOptions fit = options->fit_options;
+    fit.data_path = options->data_path;
+    fit.rate_hz = options->rate_hz;
+    fit.columns = options->columns;
+    fit.out_path = options->out_path;
+    fit.points_per_octave = options->points_per_octave;
+    if (!options->unit.empty()) {
+      fmt::print(stderr,
+                 "error: --unit: {} is not allowed; allowed: with --fit, units come "
+                 "from the column names\n",
+                 options->unit);
+      return kExitBadJob;
+    }
+    return RunAllanFit(fit);
+  };
 });
 
 }  // namespace

@@ -1,0 +1,86 @@
+// Datasheet -> error model (issue 5, item 5): a datasheet summary file holds the figures of an
+// IMU's datasheet with their units as printed ("0.15 deg/√h", "25 µg/√Hz", "±450 deg/s"); this
+// module converts them through the units module (units.h) into an ImuErrorModel (SI,
+// sensor_params.h) with the mapping of presets.h, and lists every derived SI value.
+//
+// File format (a subset of YAML: block or one-line flow mappings of scalars, '#' comments):
+//
+//   name: stim300                       # optional, the model's name
+//   description: "STIM300 rev. 9 ..."   # optional
+//   gyro:
+//     arw: "0.15 deg/√h"                # or rate_noise_density: "0.0025 (deg/s)/√Hz"
+//     bias_instability: "0.5 deg/h"
+//     range: "±400 deg/s"
+//   accel: {vrw: "0.06 m/s/√h", bias_instability: "0.05 mg", range: "±10 g"}
+//
+// Keys of `gyro` (dimension; model field):
+//   arw | rate_noise_density   angle random walk (deg/√h, (deg/s)/√Hz, ...); white_noise_density
+//   bias_instability           angular rate (deg/h, ...); bias_flicker.bias_instability (Allan
+//                              minimum / 0.664, IEEE Std 952-1997 C.1)
+//   bias_instability_tau_min, bias_instability_tau_max   time (s, min, h); the flicker band,
+//                              default 1 s and 1000 s as the catalogue presets
+//   gauss_markov_sigma, gauss_markov_tau   angular rate, time; bias_gauss_markov
+//   rate_random_walk           (deg/h)/√h, ...; random_walk
+//   turn_on_bias               angular rate; turn_on_bias_sigma (bias repeatability, 1 sigma)
+//   scale_factor               ratio (ppm, %); scale_factor_sigma
+//   misalignment               angle (mrad, deg, ...); misalignment_sigma_rad
+//   quantization               angle (urad, arcsec, ...); quantization (LSB of the increment)
+//   range                      angular rate; range
+//   g_sensitivity              angular rate per acceleration ((deg/h)/g, (deg/s)/g); gyro
+//                              g-sensitivity, on the diagonal
+// Keys of `accel`: vrw | noise_density (velocity random walk: m/s/√h, µg/√Hz), bias_instability,
+//   bias_instability_tau_min/_max, gauss_markov_sigma/_tau, acceleration_random_walk (µg/√s,
+//   (m/s²)/√s ...), turn_on_bias, scale_factor, misalignment, quantization (velocity: mm/s, m/s),
+//   range (acceleration: g, m/s²).
+// Every figure is a magnitude (a leading "±", "+-" or "+/-" as printed is accepted); a negative
+// value, an unknown key, a unit of the wrong dimension or a malformed number is a SpecError naming
+// the key path ("gyro.arw"), the text and the allowed units. Unknown keys list the allowed ones.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "driftlab/sensor_params.h"
+#include "driftlab/units.h"
+
+namespace driftlab::calib {
+
+// One converted datasheet figure.
+struct DatasheetValue {
+  std::string key;   // "gyro.arw"
+  std::string text;  // as written, "0.15 deg/√h"
+  double value_si = 0.0;
+  std::string si_unit;  // "rad/sqrt(s)"
+  std::string field;    // model field, "gyro.white_noise_density"
+};
+
+struct DatasheetModel {
+  ImuErrorModel model;
+  std::vector<DatasheetValue> values;  // in file order
+};
+
+// Entries of a parsed file: "name", "description", "gyro.<key>", "accel.<key>" with their text
+// and the line they came from (for messages).
+struct DatasheetEntry {
+  std::string key;
+  std::string text;
+  int line = 0;
+};
+
+// Parses the YAML subset above. `source` names the text in messages ("file.yaml:12"). Throws
+// SpecError for a syntax error, a duplicate key or a top-level key other than name, description,
+// gyro, accel.
+std::vector<DatasheetEntry> ParseDatasheetText(std::string_view text, std::string_view source);
+
+// Converts entries to the model and validates it (ValidateImuErrorModel). Throws SpecError.
+DatasheetModel DatasheetToModel(const std::vector<DatasheetEntry>& entries);
+
+// Reads and converts a datasheet file. Throws SpecError (also for an unreadable file).
+DatasheetModel LoadDatasheet(const std::filesystem::path& path);
+
+// The SI unit text of a dimension used here ("rad/sqrt(s)", "m/s^2", ...).
+std::string SiUnitText(Dimension dimension);
+
+}  // namespace driftlab::calib

@@ -1,0 +1,121 @@
+// Noise-model fit of Allan-deviation curves (issue 5, item 4): a weighted least-squares fit, with
+// Ceres, of the IEEE Std 952-1997 Annex C noise terms to one or more overlapping Allan-deviation
+// curves of a sensor (allan.h), giving each term with its 1-sigma uncertainty and a triad error
+// model (sensor_params.h) that the engine can simulate.
+//
+// Model (Allan variance [u^2] at averaging time t [s]; u = rad/s for a gyro, m/s^2 for an
+// accelerometer; IEEE Std 952-1997 Annex C, table C.2):
+//   AVAR(t) = 3 Q^2 / t^2 + N^2 / t + B^2 F(t) + K^2 t / 3 + R^2 t^2 / 2
+//   Q quantization [u s] (rad or m/s), N white noise [u/sqrt(Hz)] (ARW / VRW), B bias instability
+//   [u], K rate / acceleration random walk [u sqrt(Hz)], R rate ramp [u/s];
+//   F(t) = 2 ln 2 / pi (flat flicker floor, 0.664^2; BiasModel::kFlickerFlat), or the Allan
+//   variance per unit B^2 of the engine's band-limited flicker approximation over
+//   [flicker_tau_min_s, flicker_tau_max_s] (DesignFlickerApproximation; kFlickerBand), or instead
+//   of B^2 F(t) a first-order Gauss-Markov bias sigma^2 A_GM(t; tau) (GaussMarkovAllanVariance;
+//   kGaussMarkov).
+//
+// Fit: the model is linear in the variance coefficients a = (Q^2, N^2, B^2 or sigma_GM^2, K^2,
+// R^2), each kept >= 0 by a Ceres lower bound (so a term can sit at 0 with a finite Jacobian and a
+// finite covariance); the Gauss-Markov correlation time enters as ln tau. The residual of point i
+//   r_i = (ln AVAR_model(t_i) - [ln AVAR_i - b(edf_i)]) / s_i,   s_i = sqrt(2 / edf_i)
+// weights every tau by its confidence: AVAR_i edf_i / AVAR is chi-square with edf_i degrees of
+// freedom, so var(ln AVAR_i) = psi'(edf/2) ~ 2 / edf and E[ln AVAR_i] - ln AVAR = psi(edf/2) -
+// ln(edf/2) = b(edf) ~ -1/edf (bias removed; NIST SP 1065 section 5.3 for the chi-square model).
+// Uncertainties: ceres::Covariance of the coefficients, scaled by the reduced chi-square when it
+// exceeds 1 (the octave-spaced ADEV points are not independent, which this partly absorbs); a
+// term's amplitude c = sqrt(a) has sigma_c = sigma_a / (2 c).
+//
+// Determination: a term is "determined" when a >= determined_sigmas * sigma_a. Undetermined terms
+// are reported with an upper bound c_up = sqrt(max(a, 0) + 2 sigma_a) (about 97.7 % one-sided),
+// set to 0 and the fit is repeated without them, so that the model and the uncertainties of the
+// remaining terms are those of the determined model.
+#pragma once
+
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "driftlab/allan.h"
+#include "driftlab/sensor_params.h"
+
+namespace driftlab::calib {
+
+enum class BiasModel {
+  kFlickerFlat,  // IEEE flat floor (2 ln 2 / pi) B^2 at every tau
+  kFlickerBand,  // the engine's flicker approximation over [flicker_tau_min_s, flicker_tau_max_s]
+  kGaussMarkov,  // first-order Gauss-Markov bias, sigma and tau fitted
+  kNone,         // no bias-instability term
+};
+
+struct NoiseFitOptions {
+  BiasModel bias_model = BiasModel::kFlickerFlat;
+  // Flicker band [s]: kFlickerBand uses it in the fit; both flicker models write it into the
+  // triad model (FlickerParams). 0 = the first / last tau of the curves.
+  double flicker_tau_min_s = 0.0;
+  double flicker_tau_max_s = 0.0;
+  bool fit_quantization = true;
+  bool fit_white_noise = true;
+  bool fit_random_walk = true;
+  bool fit_rate_ramp = true;
+  // A term is determined when its variance coefficient a >= determined_sigmas * sigma_a
+  // (3: a term absent from the data is called determined with probability ~0.1 %).
+  double determined_sigmas = 3.0;
+  int max_iterations = 200;
+};
+
+// One fitted term in SI units (see the model above for each term's unit).
+struct NoiseTermEstimate {
+  bool fitted = false;                                      // the term was part of the model
+  bool determined = false;                                  // the data determine it (see above)
+  double value = 0.0;                                       // amplitude; 0 when not determined
+  double sigma = std::numeric_limits<double>::quiet_NaN();  // 1 sigma of value
+  double upper_bound = std::numeric_limits<double>::quiet_NaN();  // when not determined
+};
+
+struct NoiseFitResult {
+  NoiseTermEstimate quantization;        // Q [rad] or [m/s] (IEEE Q = LSB / sqrt(12))
+  NoiseTermEstimate white_noise;         // N
+  NoiseTermEstimate bias_instability;    // B (flicker) or sigma (Gauss-Markov)
+  NoiseTermEstimate gauss_markov_tau_s;  // Gauss-Markov correlation time [s] (kGaussMarkov only)
+  NoiseTermEstimate random_walk;         // K
+  NoiseTermEstimate rate_ramp;           // R (no term in the engine's model; reported only)
+  BiasModel bias_model = BiasModel::kFlickerFlat;
+  double flicker_tau_min_s = 0.0;  // band written into the triad model
+  double flicker_tau_max_s = 0.0;
+  int n_points = 0;           // ADEV points used (all curves)
+  int n_parameters = 0;       // in the final fit
+  double residual_rms = 0.0;  // RMS of the normalised residuals r_i (~1 for a good fit)
+  double chi2_per_dof = 0.0;  // sum r_i^2 / (n_points - n_parameters)
+  int iterations = 0;         // Ceres iterations, all passes
+  int passes = 0;             // fits run (one more per round of dropped terms)
+  double fit_time_s = 0.0;
+};
+
+// Fits the model to the curves (all of one sensor kind, e.g. the three axes of a triad: one
+// parameter set for all). Points with edf <= 0 or adev <= 0 are skipped. Throws SpecError for
+// no usable points, fewer points than parameters, an invalid option or a failed covariance.
+NoiseFitResult FitAllanNoiseModel(std::span<const std::vector<AllanPoint>> curves,
+                                  const NoiseFitOptions& options = {});
+NoiseFitResult FitAllanNoiseModel(std::span<const AllanPoint> curve,
+                                  const NoiseFitOptions& options = {});
+
+// Allan deviation [u] of the fitted model at t (determined terms only).
+double FittedAllanDeviation(const NoiseFitResult& fit, double tau_s);
+
+// The noise terms of the fit as a triad model: white_noise_density = N, random_walk = K,
+// quantization (LSB) = sqrt(12) Q, bias_flicker = {B, band} or bias_gauss_markov = {sigma, tau};
+// all other fields zero. The rate ramp has no term in TriadErrorParams and is left out.
+TriadErrorParams ToTriadErrorParams(const NoiseFitResult& fit);
+
+// Text table of the fitted terms (value +- 1 sigma, or "not determined (< upper bound)") in
+// datasheet units, next to `reference` (e.g. a datasheet's or preset's triad) when given.
+// gyro selects the units: deg/sqrt(h), deg/h, deg/h/sqrt(h), urad, deg/h/h; else m/s/sqrt(h), ug,
+// ug/sqrt(s), mm/s, ug/h.
+std::string FormatNoiseFit(const NoiseFitResult& fit, bool gyro,
+                           const TriadErrorParams* reference = nullptr,
+                           const std::string& reference_name = "");
+
+const char* BiasModelName(BiasModel model);
+
+}  // namespace driftlab::calib

@@ -1,0 +1,476 @@
+// Noise-model fit of Allan-deviation curves (noise_fit.h states the model, weights and rules).
+#include "driftlab/calib/noise_fit.h"
+
+#include <ceres/ceres.h>
+#include <ceres/covariance.h>
+#include <ceres/manifold.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "driftlab/sensors.h"
+#include "driftlab/spec_error.h"
+#include "driftlab/units.h"
+
+namespace driftlab::calib {
+namespace {
+
+constexpr int kQ = 0, kN = 1, kB = 2, kK = 3, kR = 4, kTerms = 5;
+// IEEE Std 952-1997 table C.2: flicker floor AVAR = (2 ln 2 / pi) B^2.
+const double kFlickerFloor = 2.0 * std::numbers::ln2 / std::numbers::pi;
+
+// psi(x) and psi'(x) for x > 0: recurrence up to x >= 6, then the asymptotic series
+// (Abramowitz & Stegun 6.3.5, 6.3.18, 6.4.6, 6.4.12); error < 1e-10 there.
+double Digamma(double x) {
+  double r = 0.0;
+  while (x < 6.0) {
+    r -= 1.0 / x;
+    x += 1.0;
+  }
+  const double x2 = 1.0 / (x * x);
+  return r + std::log(x) - 0.5 / x -
+         x2 * (1.0 / 12.0 - x2 * (1.0 / 120.0 - x2 * (1.0 / 252.0 - x2 / 240.0)));
+}
+
+double Trigamma(double x) {
+  double r = 0.0;
+  while (x < 6.0) {
+    r += 1.0 / (x * x);
+    x += 1.0;
+  }
+  const double x2 = 1.0 / (x * x);
+  return r + 1.0 / x + 0.5 * x2 +
+         x2 / x * (1.0 / 6.0 - x2 * (1.0 / 30.0 - x2 * (1.0 / 42.0 - x2 / 30.0)));
+}
+
+struct FitPoint {
+  double tau_s = 0.0;
+  double y = 0.0;                      // ln AVAR - b(edf)
+  double sigma = 0.0;                  // sqrt(psi'(edf / 2))
+  std::array<double, kTerms> basis{};  // f_k(t); the Gauss-Markov slot is computed from tau
+};
+
+double GaussMarkovShape(double tau_gm_s, double t) {
+  return GaussMarkovAllanVariance(1.0, tau_gm_s, t);
+}
+
+// One ADEV point: r = (ln sum_k s_k x_k f_k(t) - y) / sigma. Parameter blocks: x (kTerms) and, for
+// the Gauss-Markov model, ln tau (1).
+class PointCost final : public ceres::CostFunction {
+ public:
+  PointCost(const FitPoint& point, const std::array<double, kTerms>& scale, bool gauss_markov)
+      : point_(point), scale_(scale), gauss_markov_(gauss_markov) {
+    set_num_residuals(1);
+    mutable_parameter_block_sizes()->push_back(kTerms);
+    if (gauss_markov_) mutable_parameter_block_sizes()->push_back(1);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double* x = parameters[0];
+    std::array<double, kTerms> f = point_.basis;
+    double d_gm = 0.0;  // d f_B / d ln tau
+    if (gauss_markov_) {
+      const double tau = std::exp(parameters[1][0]);
+      f[kB] = GaussMarkovShape(tau, point_.tau_s);
+      // Central difference in ln tau, step 1e-4: truncation error ~ h^2 / 6 f''' ~ 2e-9 relative.
+      constexpr double kH = 1e-4;
+      d_gm = (GaussMarkovShape(tau * std::exp(kH), point_.tau_s) -
+              GaussMarkovShape(tau * std::exp(-kH), point_.tau_s)) /
+             (2.0 * kH);
+    }
+    double model = 0.0;
+    for (int k = 0; k < kTerms; ++k) model += scale_[k] * x[k] * f[k];
+    if (!(model > 0.0) || !std::isfinite(model)) return false;
+    residuals[0] = (std::log(model) - point_.y) / point_.sigma;
+    if (jacobians != nullptr) {
+      const double g = 1.0 / (model * point_.sigma);
+      if (jacobians[0] != nullptr) {
+        for (int k = 0; k < kTerms; ++k) jacobians[0][k] = scale_[k] * f[k] * g;
+      }
+      if (gauss_markov_ && jacobians[1] != nullptr) {
+        jacobians[1][0] = scale_[kB] * x[kB] * d_gm * g;
+      }
+    }
+    return true;
+  }
+
+ private:
+  FitPoint point_;
+  std::array<double, kTerms> scale_;
+  bool gauss_markov_;
+};
+
+double FlickerShape(BiasModel model, double tau_min_s, double tau_max_s, double t) {
+  if (model == BiasModel::kFlickerFlat) return kFlickerFloor;
+  const double adev =
+      SumOfGaussMarkovAllanDeviation(DesignFlickerApproximation({1.0, tau_min_s, tau_max_s}), t);
+  return adev * adev;
+}
+
+std::array<double, kTerms> Basis(BiasModel model, double tau_min_s, double tau_max_s, double t) {
+  std::array<double, kTerms> f{};
+  f[kQ] = 3.0 / (t * t);
+  f[kN] = 1.0 / t;
+  f[kB] = (model == BiasModel::kFlickerFlat || model == BiasModel::kFlickerBand)
+              ? FlickerShape(model, tau_min_s, tau_max_s, t)
+              : 0.0;
+  f[kK] = t / 3.0;
+  f[kR] = t * t / 2.0;
+  return f;
+}
+
+NoiseTermEstimate* Term(NoiseFitResult& r, int k) {
+  switch (k) {
+    case kQ:
+      return &r.quantization;
+    case kN:
+      return &r.white_noise;
+    case kB:
+      return &r.bias_instability;
+    case kK:
+      return &r.random_walk;
+    default:
+      return &r.rate_ramp;
+  }
+}
+
+}  // namespace
+
+const char* BiasModelName(BiasModel model) {
+  switch (model) {
+    case BiasModel::kFlickerFlat:
+      return "flicker (IEEE flat floor)";
+    case BiasModel::kFlickerBand:
+      return "flicker (engine band)";
+    case BiasModel::kGaussMarkov:
+      return "Gauss-Markov";
+    case BiasModel::kNone:
+      break;
+  }
+  return "none";
+}
+
+NoiseFitResult FitAllanNoiseModel(std::span<const AllanPoint> curve,
+                                  const NoiseFitOptions& options) {
+  const std::vector<AllanPoint> copy(curve.begin(), curve.end());
+  return FitAllanNoiseModel(std::span<const std::vector<AllanPoint>>(&copy, 1), options);
+}
+
+NoiseFitResult FitAllanNoiseModel(std::span<const std::vector<AllanPoint>> curves,
+                                  const NoiseFitOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  if (!(options.determined_sigmas > 0.0) || !std::isfinite(options.determined_sigmas)) {
+    throw SpecError("noise_fit.determined_sigmas", std::to_string(options.determined_sigmas),
+                    "> 0 (finite)");
+  }
+  if (options.max_iterations < 1) {
+    throw SpecError("noise_fit.max_iterations", std::to_string(options.max_iterations), ">= 1");
+  }
+  // Tau range of the usable points.
+  double tau_first = INFINITY, tau_last = 0.0;
+  for (const auto& c : curves) {
+    for (const AllanPoint& p : c) {
+      if (p.edf > 0.0 && p.adev > 0.0 && std::isfinite(p.adev) && p.tau_s > 0.0) {
+        tau_first = std::min(tau_first, p.tau_s);
+        tau_last = std::max(tau_last, p.tau_s);
+      }
+    }
+  }
+  if (!(tau_last > 0.0)) {
+    throw SpecError("allan curve", "no point with adev > 0 and edf > 0",
+                    "an Allan-deviation curve of a noisy signal (at least one usable point)");
+  }
+  NoiseFitResult result;
+  result.bias_model = options.bias_model;
+  result.flicker_tau_min_s =
+      options.flicker_tau_min_s > 0.0 ? options.flicker_tau_min_s : tau_first;
+  result.flicker_tau_max_s = options.flicker_tau_max_s > 0.0 ? options.flicker_tau_max_s : tau_last;
+  const bool flicker = options.bias_model == BiasModel::kFlickerFlat ||
+                       options.bias_model == BiasModel::kFlickerBand;
+  if (flicker && !(result.flicker_tau_min_s < result.flicker_tau_max_s &&
+                   result.flicker_tau_max_s / result.flicker_tau_min_s <= kMaxFlickerRangeRatio)) {
+    throw SpecError("noise_fit.flicker_tau_min_s",
+                    std::to_string(result.flicker_tau_min_s) + " s (tau_max_s " +
+                        std::to_string(result.flicker_tau_max_s) + " s)",
+                    "0 < flicker_tau_min_s < flicker_tau_max_s <= 1e9 flicker_tau_min_s");
+  }
+  const bool gauss_markov = options.bias_model == BiasModel::kGaussMarkov;
+
+  std::vector<FitPoint> points;
+  for (const auto& c : curves) {
+    for (const AllanPoint& p : c) {
+      if (!(p.edf > 0.0 && p.adev > 0.0 && std::isfinite(p.adev) && p.tau_s > 0.0)) continue;
+      FitPoint fp;
+      fp.tau_s = p.tau_s;
+      const double half_edf = 0.5 * p.edf;
+      fp.y = 2.0 * std::log(p.adev) - (Digamma(half_edf) - std::log(half_edf));
+      fp.sigma = std::sqrt(Trigamma(half_edf));
+      fp.basis =
+          Basis(options.bias_model, result.flicker_tau_min_s, result.flicker_tau_max_s, p.tau_s);
+      points.push_back(fp);
+    }
+  }
+
+  std::array<bool, kTerms> active = {options.fit_quantization, options.fit_white_noise,
+                                     options.bias_model != BiasModel::kNone,
+                                     options.fit_random_walk, options.fit_rate_ramp};
+  for (int k = 0; k < kTerms; ++k) Term(result, k)->fitted = active[k];
+  result.gauss_markov_tau_s.fitted = gauss_markov;
+
+  // Scale of each coefficient: the largest variance the term alone may have without exceeding
+  // the data at any point, s_k = min_i AVAR_i / f_k(t_i); x_k = a_k / s_k is then O(1) or less.
+  double ln_tau_gm = std::log(std::sqrt(tau_first * tau_last));
+  std::array<double, kTerms> scale{};
+  for (int k = 0; k < kTerms; ++k) {
+    scale[k] = INFINITY;
+    for (const FitPoint& p : points) {
+      const double f =
+          (k == kB && gauss_markov) ? GaussMarkovShape(std::exp(ln_tau_gm), p.tau_s) : p.basis[k];
+      if (f > 0.0) scale[k] = std::min(scale[k], std::exp(p.y) / f);
+    }
+    if (!std::isfinite(scale[k]) || !(scale[k] > 0.0)) active[k] = false;
+  }
+
+  std::array<double, kTerms> x{};
+  std::array<double, kTerms> sigma_x{};
+  double sigma_ln_tau = NAN;
+  double chi2 = 0.0;
+  for (int pass = 0; pass < kTerms + 1; ++pass) {
+    int n_active = 0;
+    for (int k = 0; k < kTerms; ++k) n_active += active[k] ? 1 : 0;
+    const bool fit_tau = gauss_markov && active[kB];
+    const int n_parameters = n_active + (fit_tau ? 1 : 0);
+    if (n_active == 0) {
+      throw SpecError("allan curve", "no noise term is determined by the data",
+                      "a curve on which at least one term stands out of its confidence intervals");
+    }
+    if (static_cast<int>(points.size()) <= n_parameters) {
+      throw SpecError("allan curve", std::to_string(points.size()) + " usable points",
+                      "more points than fitted parameters (" + std::to_string(n_parameters) +
+                          "): a longer record or a denser tau grid");
+    }
+    for (int k = 0; k < kTerms; ++k) x[k] = active[k] ? (x[k] > 0.0 ? x[k] : 0.5) : 0.0;
+
+    ceres::Problem::Options problem_options;
+    ceres::Problem problem(problem_options);
+    for (const FitPoint& p : points) {
+      if (gauss_markov) {
+        problem.AddResidualBlock(new PointCost(p, scale, true), nullptr, x.data(), &ln_tau_gm);
+      } else {
+        problem.AddResidualBlock(new PointCost(p, scale, false), nullptr, x.data());
+      }
+    }
+    std::vector<int> fixed;
+    for (int k = 0; k < kTerms; ++k) {
+      if (!active[k]) {
+        fixed.push_back(k);
+      } else {
+        problem.SetParameterLowerBound(x.data(), k, 0.0);
+      }
+    }
+    if (!fixed.empty()) problem.SetManifold(x.data(), new ceres::SubsetManifold(kTerms, fixed));
+    if (gauss_markov) {
+      if (fit_tau) {
+        // tau between a tenth of the shortest and ten times the longest averaging time.
+        problem.SetParameterLowerBound(&ln_tau_gm, 0, std::log(tau_first / 10.0));
+        problem.SetParameterUpperBound(&ln_tau_gm, 0, std::log(tau_last * 10.0));
+      } else {
+        problem.SetParameterBlockConstant(&ln_tau_gm);
+      }
+    }
+
+    ceres::Solver::Options solver_options;
+    solver_options.linear_solver_type = ceres::DENSE_QR;
+    solver_options.max_num_iterations = options.max_iterations;
+    solver_options.function_tolerance = 1e-14;
+    solver_options.gradient_tolerance = 1e-14;
+    solver_options.parameter_tolerance = 1e-12;
+    solver_options.logging_type = ceres::SILENT;
+    solver_options.num_threads = 1;
+    ceres::Solver::Summary summary;
+    ceres::Solve(solver_options, &problem, &summary);
+    result.iterations += static_cast<int>(summary.iterations.size());
+    ++result.passes;
+    if (!summary.IsSolutionUsable()) {
+      throw SpecError("allan curve", "the noise-model fit failed (" + summary.message + ")",
+                      "a curve the model can describe");
+    }
+    chi2 = 2.0 * summary.final_cost;
+    const int dof = static_cast<int>(points.size()) - n_parameters;
+    const double inflation = std::max(1.0, chi2 / dof);
+
+    ceres::Covariance::Options covariance_options;
+    covariance_options.algorithm_type = ceres::DENSE_SVD;
+    ceres::Covariance covariance(covariance_options);
+    std::vector<std::pair<const double*, const double*>> blocks = {{x.data(), x.data()}};
+    if (fit_tau) blocks.push_back({&ln_tau_gm, &ln_tau_gm});
+    if (!covariance.Compute(blocks, &problem)) {
+      throw SpecError("allan curve",
+                      "the fitted noise terms are not separable on this tau range (singular "
+                      "covariance)",
+                      "a curve spanning the terms' slopes, or fewer fitted terms");
+    }
+    std::array<double, kTerms * kTerms> c{};
+    covariance.GetCovarianceBlock(x.data(), x.data(), c.data());
+    for (int k = 0; k < kTerms; ++k)
+      sigma_x[k] = std::sqrt(std::max(0.0, c[k * kTerms + k]) * inflation);
+    if (fit_tau) {
+      double c_tau = 0.0;
+      covariance.GetCovarianceBlock(&ln_tau_gm, &ln_tau_gm, &c_tau);
+      sigma_ln_tau = std::sqrt(std::max(0.0, c_tau) * inflation);
+    }
+
+    result.n_parameters = n_parameters;
+    bool dropped = false;
+    for (int k = 0; k < kTerms; ++k) {
+      if (!active[k]) continue;
+      const double a = scale[k] * x[k];
+      const double sigma_a = scale[k] * sigma_x[k];
+      if (!(a >= options.determined_sigmas * sigma_a) || !(a > 0.0)) {
+        NoiseTermEstimate& t = *Term(result, k);
+        t.determined = false;
+        t.value = 0.0;
+        t.sigma = NAN;
+        t.upper_bound = std::sqrt(std::max(a, 0.0) + 2.0 * sigma_a);
+        active[k] = false;
+        x[k] = 0.0;
+        dropped = true;
+      }
+    }
+    if (!dropped) break;
+  }
+
+  for (int k = 0; k < kTerms; ++k) {
+    if (!active[k]) continue;
+    NoiseTermEstimate& t = *Term(result, k);
+    const double a = scale[k] * x[k];
+    t.determined = true;
+    t.value = std::sqrt(a);
+    t.sigma = scale[k] * sigma_x[k] / (2.0 * t.value);  // sigma_c = sigma_a / (2 c)
+    t.upper_bound = NAN;
+  }
+  if (gauss_markov) {
+    NoiseTermEstimate& t = result.gauss_markov_tau_s;
+    if (active[kB]) {
+      t.determined = true;
+      t.value = std::exp(ln_tau_gm);
+      t.sigma = t.value * sigma_ln_tau;  // d tau = tau d ln tau
+    } else {
+      t.determined = false;
+      t.value = 0.0;
+    }
+  }
+  result.n_points = static_cast<int>(points.size());
+  result.chi2_per_dof = chi2 / (result.n_points - result.n_parameters);
+  result.residual_rms = std::sqrt(chi2 / result.n_points);
+  result.fit_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return result;
+}
+
+double FittedAllanDeviation(const NoiseFitResult& fit, double tau_s) {
+  std::array<double, kTerms> f =
+      Basis(fit.bias_model, fit.flicker_tau_min_s, fit.flicker_tau_max_s, tau_s);
+  if (fit.bias_model == BiasModel::kGaussMarkov && fit.gauss_markov_tau_s.determined) {
+    f[kB] = GaussMarkovShape(fit.gauss_markov_tau_s.value, tau_s);
+  }
+  NoiseFitResult copy = fit;
+  double avar = 0.0;
+  for (int k = 0; k < kTerms; ++k) {
+    const double c = Term(copy, k)->value;
+    avar += c * c * f[k];
+  }
+  return std::sqrt(avar);
+}
+
+TriadErrorParams ToTriadErrorParams(const NoiseFitResult& fit) {
+  TriadErrorParams p;
+  p.white_noise_density = fit.white_noise.value;
+  p.random_walk = fit.random_walk.value;
+  // IEEE Std 952-1997 C.1: quantization noise coefficient Q = S / sqrt(12), S the LSB.
+  p.quantization = std::sqrt(12.0) * fit.quantization.value;
+  if (fit.bias_instability.value > 0.0) {
+    if (fit.bias_model == BiasModel::kGaussMarkov) {
+      p.bias_gauss_markov = {fit.bias_instability.value, fit.gauss_markov_tau_s.value};
+    } else {
+      p.bias_flicker = {fit.bias_instability.value, fit.flicker_tau_min_s, fit.flicker_tau_max_s};
+    }
+  }
+  return p;
+}
+
+std::string FormatNoiseFit(const NoiseFitResult& fit, bool gyro, const TriadErrorParams* reference,
+                           const std::string& reference_name) {
+  struct Row {
+    const char* label;
+    const NoiseTermEstimate* term;
+    const char* unit;
+    double reference;  // SI, NaN = none
+  };
+  const bool gm = fit.bias_model == BiasModel::kGaussMarkov;
+  const double nan = NAN;
+  auto ref = [&](double v) { return reference != nullptr ? v : nan; };
+  const std::vector<Row> rows = {
+      {gyro ? "white noise N (ARW)" : "white noise N (VRW)", &fit.white_noise,
+       gyro ? "deg/sqrt(h)" : "m/s/sqrt(h)", ref(reference ? reference->white_noise_density : 0)},
+      {gm ? "Gauss-Markov sigma" : "bias instability B", &fit.bias_instability,
+       gyro ? "deg/h" : "ug",
+       ref(reference ? (gm ? reference->bias_gauss_markov.sigma
+                           : reference->bias_flicker.bias_instability)
+                     : 0)},
+      {"Gauss-Markov tau", gm ? &fit.gauss_markov_tau_s : nullptr, "s",
+       ref(reference ? reference->bias_gauss_markov.tau_s : 0)},
+      {gyro ? "rate random walk K" : "accel random walk K", &fit.random_walk,
+       gyro ? "deg/h/sqrt(h)" : "ug/sqrt(s)", ref(reference ? reference->random_walk : 0)},
+      {"quantization Q", &fit.quantization, gyro ? "urad" : "mm/s",
+       ref(reference ? reference->quantization / std::sqrt(12.0) : 0)},
+      {"rate ramp R", &fit.rate_ramp, gyro ? "deg/h/h" : "ug/h", nan},
+  };
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line, "  %-22s %-38s %s\n", "term", "fitted (+- 1 sigma)",
+                reference != nullptr ? reference_name.c_str() : "");
+  out += line;
+  for (const Row& row : rows) {
+    if (row.term == nullptr || !row.term->fitted) continue;
+    std::string fitted;
+    if (row.term->determined) {
+      fitted = FormatQuantity(row.term->value, row.unit, 4) + " +- " +
+               FormatQuantity(row.term->sigma, row.unit, 2);
+    } else if (std::isfinite(row.term->upper_bound)) {
+      fitted = "not determined (< " + FormatQuantity(row.term->upper_bound, row.unit, 3) + ")";
+    } else {
+      fitted = "not determined";
+    }
+    std::string ref_text;
+    if (std::isfinite(row.reference)) {
+      ref_text = row.reference > 0.0 ? FormatQuantity(row.reference, row.unit, 4) : "-";
+      if (row.reference > 0.0 && row.term->determined) {
+        char diff[64];
+        std::snprintf(diff, sizeof diff, "  (fit %+.1f %%)",
+                      100.0 * (row.term->value / row.reference - 1.0));
+        ref_text += diff;
+      }
+    }
+    std::snprintf(line, sizeof line, "  %-22s %-38s %s\n", row.label, fitted.c_str(),
+                  ref_text.c_str());
+    out += line;
+  }
+  std::snprintf(line, sizeof line,
+                "  bias model: %s; %d points, %d parameters, residual RMS %.3g, chi2/dof %.3g, "
+                "%d iterations\n",
+                BiasModelName(fit.bias_model), fit.n_points, fit.n_parameters, fit.residual_rms,
+                fit.chi2_per_dof, fit.iterations);
+  out += line;
+  return out;
+}
+
+}  // namespace driftlab::calib

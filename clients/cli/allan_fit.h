@@ -1,0 +1,32 @@
+// Allan-deviation noise-model fit of a recording (issue 5, item 7: `driftlab allan DATA.csv --fit
+// --out MODEL.json`): reads the CSV columns (default: driftlab imu.csv point samples
+// omega_{x,y,z}_rad_per_s and f_{x,y,z}_m_per_s2), computes each column's overlapping Allan
+// deviation (allan.h), fits the IEEE Std 952 noise terms per axis and per triad
+// (calib/noise_fit.h), prints them +- 1 sigma in datasheet units (next to a datasheet's figures
+// when one is given) and writes the triad fits as a job-schema sensor fragment.
+#pragma once
+
+#include <string>
+
+namespace driftlab::cli {
+
+struct AllanFitOptions {
+  std::string data_path;
+  double rate_hz = 0.0;
+  // Comma-separated column names; units from the name suffix (_rad_per_s, _deg_per_s,
+  // _deg_per_h, _m_per_s2, _g, _mg, _ug). Angular-rate columns form the gyro triad,
+  // acceleration columns the accelerometer triad. Empty = the imu.csv columns.
+  std::string columns;
+  std::string out_path;        // MODEL.json ({"sensor": {...}}); empty = not written
+  std::string datasheet_path;  // datasheet summary to compare with (calib/datasheet.h)
+  int points_per_octave = 1;
+  std::string bias_model = "flicker";  // flicker | gauss-markov | none
+  double flicker_tau_min_s = 0.0;      // 0 = first tau of the curve
+  double flicker_tau_max_s = 0.0;      // 0 = last tau
+};
+
+// Returns the exit status (commands.h: 0 ok, 1 I/O failure, 2 bad data or options); messages go
+// to stderr.
+int RunAllanFit(const AllanFitOptions& options);
+
+}  // namespace driftlab::cli
