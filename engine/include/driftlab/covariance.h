@@ -1,0 +1,69 @@
+// Linear covariance analysis: the covariance P of the 15-state error model (error_state.h)
+// propagated along the truth trajectory, P(k+1) = Phi P(k) Phi^T + Q_d, giving the predicted
+// 1-sigma of every navigation error component against time: the number a Monte-Carlo run of the
+// same IMU model must reproduce (for the terms the model represents; MakeErrorStateNoise lists the
+// others). Reference: Maybeck, "Stochastic Models, Estimation and Control", vol. 1, ch. 4 and 6
+// (covariance propagation); Groves 2nd ed. section 3.2.2 (system propagation), 14.2.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "driftlab/error_state.h"
+#include "driftlab/trajectory.h"
+
+namespace driftlab {
+
+// Propagates P over intervals; the same step serves the INS/GNSS filter's prediction.
+class ErrorCovariancePropagator {
+ public:
+  ErrorCovariancePropagator(const NavEnvironment& env, const ErrorStateNoise& noise,
+                            const ErrorStateMatrix& P0,
+                            Discretization method = Discretization::kVanLoan);
+  // P <- Phi P Phi^T + Q_d over dt_s with F at `reference` (the state at the middle of the
+  // interval) and the mean specific force over the interval f_ib_b [m/s^2]; also returns Phi.
+  const ErrorStateMatrix& Propagate(const NavState& reference, const Vector3d& f_ib_b, double dt_s);
+  const ErrorStateMatrix& P() const { return P_; }
+  ErrorStateMatrix& mutable_P() { return P_; }
+
+ private:
+  NavEnvironment env_;
+  ErrorStateNoise noise_;
+  ErrorStateMatrix Q_c_;
+  Discretization method_;
+  ErrorStateMatrix P_;
+  ErrorStateMatrix Phi_;
+  ErrorStateMatrix Q_d_;
+};
+
+// Predicted 1-sigma errors at one epoch, in the components the Monte-Carlo statistics report.
+struct CovarianceEpoch {
+  double t_s = 0.0;
+  ErrorStateVector sigma = ErrorStateVector::Zero();  // sqrt(diag P): r [m], v [m/s], psi [rad],
+                                                      //   b_a [m/s^2], b_g [rad/s]
+  Vector3d euler_sigma_rad = Vector3d::Zero();        // roll, pitch, yaw: sqrt(diag(T P_psi T^T))
+  double horizontal_sigma_m = 0.0;                    // sqrt(P_NN + P_EE) (RMS horizontal error)
+  ErrorStateMatrix P = ErrorStateMatrix::Zero();
+};
+
+struct CovarianceAnalysisOptions {
+  int64_t step_samples = 1;           // propagation interval in IMU samples, >= 1
+  int64_t epoch_every_samples = 100;  // output every this many samples (and the final one), >= 1
+  Discretization discretization = Discretization::kVanLoan;
+};
+
+// Free-inertial covariance along the truth: P0 at truth[0], propagated over the whole
+// trajectory (reference = truth at the interval's midpoint sample, f from the ideal increments:
+// f_ib_b = C_b_n(mid)^T sum_i C_b_n(i) delta_v_i / T). Epochs at samples 0, e, 2e, ... and the
+// final sample. Throws SpecError ("covariance.step_samples", "covariance.epoch_every_samples")
+// for values < 1, and when epoch_every_samples is not a multiple of step_samples.
+std::vector<CovarianceEpoch> FreeInertialCovariance(const Trajectory& trajectory,
+                                                    const ErrorStateNoise& noise,
+                                                    const ErrorStateMatrix& P0,
+                                                    const CovarianceAnalysisOptions& options);
+
+// The epoch record of P at time t_s with the truth attitude `attitude` (for the Euler sigmas).
+CovarianceEpoch MakeCovarianceEpoch(double t_s, const ErrorStateMatrix& P,
+                                    const EulerAngles& attitude);
+
+}  // namespace driftlab

@@ -1,0 +1,159 @@
+#include "driftlab/gnss.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "driftlab/attitude.h"
+#include "driftlab/spec_error.h"
+
+namespace driftlab {
+namespace {
+
+std::string Num(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.17g", x);
+  return buf;
+}
+
+void CheckSigmas(const Vector3d& s, const std::string& field) {
+  for (int i = 0; i < 3; ++i) {
+    if (!std::isfinite(s[i]) || s[i] < 0.0) {
+      throw SpecError(field + "[" + std::to_string(i) + "]", Num(s[i]), ">= 0 and finite");
+    }
+  }
+}
+
+}  // namespace
+
+void ValidateGnssConfig(const GnssConfig& c, double imu_rate_hz, const std::string& path) {
+  if (!std::isfinite(c.rate_hz) || c.rate_hz <= 0.0 || c.rate_hz > imu_rate_hz) {
+    throw SpecError(path + ".rate_hz", Num(c.rate_hz),
+                    "(0, " + Num(imu_rate_hz) + "] Hz (not above the IMU rate)");
+  }
+  const double ratio = imu_rate_hz / c.rate_hz;
+  if (std::abs(ratio - std::round(ratio)) > 1e-9 * ratio) {
+    throw SpecError(path + ".rate_hz", Num(c.rate_hz),
+                    "IMU rate " + Num(imu_rate_hz) + " Hz divided by an integer");
+  }
+  CheckSigmas(c.position_sigma_ned_m, path + ".position_sigma_ned_m");
+  CheckSigmas(c.velocity_sigma_ned_m_per_s, path + ".velocity_sigma_ned_m_per_s");
+  CheckSigmas(c.position_gauss_markov_sigma_ned_m, path + ".position_gauss_markov_sigma_ned_m");
+  if (!c.position_gauss_markov_sigma_ned_m.isZero(0.0) &&
+      (!std::isfinite(c.position_gauss_markov_tau_s) || c.position_gauss_markov_tau_s <= 0.0)) {
+    throw SpecError(path + ".position_gauss_markov_tau_s", Num(c.position_gauss_markov_tau_s),
+                    "> 0 s");
+  }
+  // The filter divides by these: a zero white sigma on a used measurement is singular.
+  for (int i = 0; i < 3; ++i) {
+    if (c.position_sigma_ned_m[i] + c.position_gauss_markov_sigma_ned_m[i] <= 0.0) {
+      throw SpecError(path + ".position_sigma_ned_m[" + std::to_string(i) + "]",
+                      Num(c.position_sigma_ned_m[i]), "> 0 (with no correlated part)");
+    }
+    if (c.use_velocity && c.velocity_sigma_ned_m_per_s[i] <= 0.0) {
+      throw SpecError(path + ".velocity_sigma_ned_m_per_s[" + std::to_string(i) + "]",
+                      Num(c.velocity_sigma_ned_m_per_s[i]), "> 0 when use_velocity");
+    }
+  }
+  if (!c.lever_arm_b_m.allFinite() || c.lever_arm_b_m.norm() > 100.0) {
+    throw SpecError(path + ".lever_arm_b_m", Num(c.lever_arm_b_m.norm()) + " m", "<= 100 m");
+  }
+  for (size_t i = 0; i < c.outages.size(); ++i) {
+    const std::string f = path + ".outages[" + std::to_string(i) + "]";
+    const GnssOutage& o = c.outages[i];
+    if (!std::isfinite(o.start_s) || o.start_s < 0.0) {
+      throw SpecError(f + ".start_s", Num(o.start_s), ">= 0 s");
+    }
+    if (!std::isfinite(o.duration_s) || o.duration_s <= 0.0) {
+      throw SpecError(f + ".duration_s", Num(o.duration_s), "> 0 s");
+    }
+    if (i > 0) {
+      const GnssOutage& p = c.outages[i - 1];
+      if (o.start_s < p.start_s + p.duration_s) {
+        throw SpecError(f + ".start_s", Num(o.start_s),
+                        ">= " + Num(p.start_s + p.duration_s) + " s (after the end of outages[" +
+                            std::to_string(i - 1) + "]; outages ascending and not overlapping)");
+      }
+    }
+  }
+}
+
+void AntennaState(const NavEnvironment& env, const NavState& body, const Vector3d& omega_ib_b,
+                  const Vector3d& lever_arm_b_m, Llh* llh, Vector3d* v_eb_n) {
+  const Matrix3d C = body.C_b_n();
+  const Vector3d l_n = C * lever_arm_b_m;
+  const double L = body.llh.lat_rad, h = body.llh.h_m;
+  llh->lat_rad = L + l_n.x() / (env.MeridianRadiusAt(L) + h);
+  llh->lon_rad = body.llh.lon_rad + l_n.y() / ((env.TransverseRadiusAt(L) + h) * std::cos(L));
+  llh->h_m = h - l_n.z();
+  *v_eb_n = body.v_eb_n + C * omega_ib_b.cross(lever_arm_b_m) - env.EarthRate(L).cross(l_n);
+}
+
+GnssSimulator::GnssSimulator(const GnssConfig& config, const NavEnvironment& env,
+                             double imu_rate_hz, uint64_t seed, uint32_t run_index,
+                             const std::string& path)
+    : config_(config), env_(env) {
+  ValidateGnssConfig(config, imu_rate_hz, path);
+  decimation_ = static_cast<int64_t>(std::llround(imu_rate_hz / config.rate_hz));
+  const double T = 1.0 / config.rate_hz;
+  const bool gm = !config.position_gauss_markov_sigma_ned_m.isZero(0.0);
+  gm_a_ = gm ? std::exp(-T / config.position_gauss_markov_tau_s) : 0.0;
+  for (uint8_t axis = 0; axis < 3; ++axis) {
+    white_position_[axis] =
+        RandomStream(seed, run_index, {SensorId::kGnss, axis, ErrorTerm::kWhiteNoise, 0});
+    white_velocity_[axis] =
+        RandomStream(seed, run_index, {SensorId::kGnss, axis, ErrorTerm::kWhiteNoise, 1});
+    gm_drive_[axis] =
+        RandomStream(seed, run_index, {SensorId::kGnss, axis, ErrorTerm::kGaussMarkov, 0});
+    if (gm) {
+      const RandomStream start(seed, run_index,
+                               {SensorId::kGnss, axis, ErrorTerm::kInitialState, 0});
+      gm_state_[axis] = config.position_gauss_markov_sigma_ned_m[axis] * start.Gaussian(0);
+    }
+  }
+}
+
+bool GnssSimulator::InOutage(double t_s) const {
+  for (const GnssOutage& o : config_.outages) {
+    if (t_s >= o.start_s && t_s < o.start_s + o.duration_s) return true;
+  }
+  return false;
+}
+
+bool GnssSimulator::Measure(int64_t k, const NavState& truth, const Vector3d& omega_ib_b,
+                            GnssMeasurement* out) {
+  if (k % decimation_ != 0) return false;
+  const int64_t j = k / decimation_;
+  // Advance the correlated error to epoch j (epoch 0 is the stationary start).
+  for (int64_t e = last_epoch_ + 1; e <= j; ++e) {
+    if (e == 0) continue;
+    for (int axis = 0; axis < 3; ++axis) {
+      const double s = config_.position_gauss_markov_sigma_ned_m[axis];
+      if (s > 0.0) {
+        gm_state_[axis] =
+            gm_a_ * gm_state_[axis] +
+            s * std::sqrt(1.0 - gm_a_ * gm_a_) * gm_drive_[axis].Gaussian(static_cast<uint64_t>(e));
+      }
+    }
+  }
+  last_epoch_ = std::max(last_epoch_, j);
+  if (InOutage(truth.t_s)) return false;
+  Llh llh;
+  Vector3d v;
+  AntennaState(env_, truth, omega_ib_b, config_.lever_arm_b_m, &llh, &v);
+  Vector3d dr, dv;
+  for (int axis = 0; axis < 3; ++axis) {
+    dr[axis] = gm_state_[axis] + config_.position_sigma_ned_m[axis] *
+                                     white_position_[axis].Gaussian(static_cast<uint64_t>(j));
+    dv[axis] = config_.velocity_sigma_ned_m_per_s[axis] *
+               white_velocity_[axis].Gaussian(static_cast<uint64_t>(j));
+  }
+  const double L = llh.lat_rad, h = llh.h_m;
+  out->t_s = truth.t_s;
+  out->llh.lat_rad = L + dr.x() / (env_.MeridianRadiusAt(L) + h);
+  out->llh.lon_rad = llh.lon_rad + dr.y() / ((env_.TransverseRadiusAt(L) + h) * std::cos(L));
+  out->llh.h_m = h - dr.z();
+  out->v_eb_n = v + dv;
+  return true;
+}
+
+}  // namespace driftlab
