@@ -7,7 +7,7 @@ packages=(
   build-essential cmake ninja-build pkg-config git ca-certificates
   libeigen3-dev libceres-dev libtbb-dev
   libprotobuf-dev protobuf-compiler libgrpc++-dev protobuf-compiler-grpc
-  libyaml-cpp-dev libcli11-dev libfmt-dev libspdlog-dev libsqlite3-dev
+  libyaml-cpp-dev libcli11-dev libfmt-dev libspdlog-dev libsqlite3-dev libssl-dev openssl
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-grpcio python3-protobuf python3-matplotlib python3-numpy
   clang-format
