@@ -20,11 +20,12 @@ namespace {
 
 using testing::DriveWithFinalStraight;
 
-// Seed 4. The per-epoch criteria below are correlated across epochs (the turn-on bias draws of
-// the runs drive all of them), so a seed fails them far more often than 5 %: for the outage test,
-// seed 2 gave an MC / predicted variance ratio of 1.16 at the end of the outage (70 % of epochs
-// inside), seed 3 0.87 (77.5 %), seed 4 1.07 (100 %): scatter on both sides, no bias.
-constexpr uint64_t kSeed = 4;
+// Seed 1, the first tried. Acceptance: every check at its Bonferroni-corrected level, family-wise
+// false alarm <= 5 % (ins_gnss_scenarios.h): NEES, 200 runs: average 15-state NEES at 5 epochs,
+// alpha = 0.01 each, chi2(3000) / 200 bounds [14.02, 16.02]; outage, 200 runs: MC / predicted
+// variance at 5 outage epochs x north, east = 10 checks, alpha = 0.005 each, chi2(200) / 200
+// bounds [0.74, 1.30].
+constexpr uint64_t kSeed = 1;
 
 TEST(InsGnssFilterSlow, NeesOfTwoHundredRunsWithinChiSquareBounds) {
   // 200 runs, 100 Hz, an epoch every second.

@@ -22,12 +22,12 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 using testing::DriveWithFinalStraight;
 
-// Seed 2. The per-epoch criteria of the two tests below are correlated across epochs (one turn-on
-// bias draw per run drives all of them), so a seed fails them more often than 5 %: with seeds 1-6
-// (100-run outage test) all passed the outage test and 5 of 6 the NEES test (seed 1: 88.5 % of
-// epochs); seed 99 failed the outage test (ratio of MC to predicted variance 1.11-1.2 with 300
-// runs, traced to a +16 % sample variance of its x-gyro bias draws).
-constexpr uint64_t kSeed = 2;
+// Seed 1, the first tried. Acceptance: every check at its Bonferroni-corrected level, family-wise
+// false alarm <= 5 % (ins_gnss_scenarios.h): NEES, 40 runs: average 15-state NEES at 5 epochs,
+// alpha = 0.01 each, chi2(600) / 40 bounds [12.86, 17.32]; outage, 60 runs: MC / predicted
+// variance at 5 outage epochs x north, east = 10 checks, alpha = 0.005 each, chi2(60) / 60 bounds
+// [0.56, 1.59].
+constexpr uint64_t kSeed = 1;
 
 TEST(InsGnssFilter, NeesOfFortyRunsWithinChiSquareBounds) {
   // 40 runs, 50 Hz, an epoch every second.
