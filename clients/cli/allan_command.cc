@@ -1,15 +1,18 @@
 // `driftlab allan DATA.csv --rate HZ [--columns a,b] [--unit U] [--points-per-octave K]
 //  [--out RESULT.json]`: overlapping Allan deviation of the columns of a CSV file, with 95 %
 // confidence intervals and the IEEE Std 952 noise-term read-off (allan.h), in datasheet units.
+// With --fit (allan_fit.h): the Ceres noise-model fit, --out MODEL.json, --report REPORT.html.
 //
 // DATA.csv: one header row (names), then numeric rows; lines starting with '#' and empty lines are
-// skipped. Default columns: the point samples of driftlab's imu.csv (omega_{x,y,z}_rad_per_s,
-// f_{x,y,z}_m_per_s2; io.h ImuCsvWriter) when all are present, else every column except a time
-// column (t, t_*, time*). A column's unit comes from --unit or from its name's suffix, words
-// joined by '_' with "per" for '/': omega_x_rad_per_s -> rad/s, f_x_m_per_s2 -> m/s2,
-// gyro_deg_per_h -> deg/h, acc_mg -> mg (units.h syntax). Rates (angular rate or acceleration)
-// are analysed as they are; increments (angle or velocity, e.g. dtheta_x_rad) are divided by the
-// sample interval 1 / rate first (allan.h: the input is the per-interval average rate).
+// skipped (jobspec::ReadNumericCsv; the column selection and units are
+// jobspec::SelectRateColumns, shared with the fit, calibration_job.h). Default columns: the point
+// samples of driftlab's imu.csv (omega_{x,y,z}_rad_per_s, f_{x,y,z}_m_per_s2; io.h ImuCsvWriter)
+// when all are present, else every column except a time column (t, t_*, time*). A column's unit
+// comes from --unit or from its name's suffix, words joined by '_' with "per" for '/':
+// omega_x_rad_per_s -> rad/s, f_x_m_per_s2 -> m/s2, gyro_deg_per_h -> deg/h, acc_mg -> mg (units.h
+// syntax). Rates (angular rate or acceleration) are analysed as they are; increments (angle or
+// velocity, e.g. dtheta_x_rad) are divided by the sample interval 1 / rate first (allan.h: the
+// input is the per-interval average rate).
 //
 // Results are printed in datasheet units: gyro ADEV and bias instability in deg/h, white noise in
 // deg/sqrt(h), rate random walk in deg/h/sqrt(h); accelerometer ADEV and bias instability in ug
@@ -20,20 +23,18 @@
 #include <google/protobuf/util/json_util.h>
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <sstream>
 #include <string>
-#include <string_view>
 #include <vector>
 
 #include "allan_fit.h"
 #include "commands.h"
 #include "driftlab/allan.h"
+#include "driftlab/jobspec/calibration_job.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/units.h"
 
@@ -41,11 +42,6 @@ namespace driftlab::cli {
 namespace {
 
 namespace pb = google::protobuf;
-namespace fs = std::filesystem;
-
-// Fewest samples with two overlapping second differences at tau = 1 / rate (n + 1 - 2m >= 2 for
-// m = 1), the least the overlapping estimator can average (allan.h).
-constexpr size_t kMinSamples = 3;
 
 struct AllanCliOptions {
   std::string data_path;
@@ -56,6 +52,7 @@ struct AllanCliOptions {
   int points_per_octave = 1;
   // --fit: the noise-model fit (allan_fit.h); --out then names the model file.
   bool fit = false;
+  std::string report_path;  // with --fit: HTML report
   AllanFitOptions fit_options;
 };
 
@@ -85,196 +82,25 @@ constexpr DisplayUnits kAccelDisplayMg{
     false,           "acceleration",  "m/s^2", "mg",  "m/s/sqrt(h)", "m/s/sqrt(s)",
     "m/s/h/sqrt(h)", "m/s^2/sqrt(s)", "mm/s",  "m/s", "mg/h",        "m/s^3"};
 
-// One selected column: name, unit, and how to turn its values into SI rates.
-struct Column {
+using Column = jobspec::RateColumn;
+
+std::vector<std::string> SplitNames(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream in(text);
   std::string name;
-  size_t index = 0;
-  std::string unit;    // as parsed (units.h syntax)
-  double to_si = 1.0;  // value * to_si = SI rate (includes * rate_hz for increments)
-  bool gyro = true;    // angle-based (else velocity-based)
-  bool increment = false;
-  std::vector<double> samples;  // SI rates
-};
-
-std::string_view Trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) {
-    s.remove_suffix(1);
+  while (std::getline(in, name, ',')) {
+    const size_t a = name.find_first_not_of(" \t"), b = name.find_last_not_of(" \t");
+    out.push_back(a == std::string::npos ? "" : name.substr(a, b - a + 1));
   }
-  return s;
-}
-
-std::vector<std::string> Split(std::string_view line, char sep) {
-  std::vector<std::string> fields;
-  size_t start = 0;
-  while (true) {
-    const size_t end = line.find(sep, start);
-    fields.emplace_back(Trim(line.substr(start, end - start)));
-    if (end == std::string_view::npos) break;
-    start = end + 1;
-  }
-  return fields;
-}
-
-std::string Join(const std::vector<std::string>& items) {
-  std::string out;
-  for (const std::string& item : items) out += (out.empty() ? "" : ", ") + item;
   return out;
 }
 
-bool IsTimeColumn(std::string name) {
-  std::transform(name.begin(), name.end(), name.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return name == "t" || name.rfind("t_", 0) == 0 || name.rfind("time", 0) == 0;
-}
-
-// Dimension check shared by --unit and name suffixes: rates, or increments of them.
-bool AcceptedDimension(Dimension d) {
-  return d == dims::kAngularRate || d == dims::kAcceleration || d == dims::kAngle ||
-         d == dims::kVelocity;
-}
-
-constexpr const char* kAllowedUnits =
-    "an angular rate (rad/s, deg/s, deg/h), an acceleration (m/s^2, g, mg, ug) or an increment "
-    "(rad, deg, m/s)";
-
-// Fills unit, to_si, gyro, increment from a parsed unit.
-void SetUnit(Column& column, const std::string& unit_text, const Unit& unit, double rate_hz) {
-  column.unit = unit_text;
-  column.gyro = unit.dimension.angle2 != 0;
-  column.increment = unit.dimension == dims::kAngle || unit.dimension == dims::kVelocity;
-  column.to_si = unit.si_factor * (column.increment ? rate_hz : 1.0);
-}
-
-// Unit from the name's suffix: the longest tail of '_'-separated words that parses as a unit of
-// an accepted dimension ("per" = '/'). Returns false if no tail does.
-bool UnitFromName(Column& column, double rate_hz) {
-  const std::vector<std::string> words = Split(column.name, '_');
-  for (size_t first = 1; first < words.size(); ++first) {
-    std::string text;
-    for (size_t i = first; i < words.size(); ++i) {
-      text += (text.empty() ? "" : " ") + (words[i] == "per" ? std::string("/") : words[i]);
-    }
-    try {
-      const Unit unit = ParseUnit(text, column.name);
-      if (AcceptedDimension(unit.dimension)) {
-        SetUnit(column, text, unit, rate_hz);
-        return true;
-      }
-    } catch (const SpecError&) {
-      // Not a unit: try a shorter tail.
-    }
-  }
-  return false;
-}
-
-// Reads the header and the selected columns of `path` as SI rates.
+// Reads `path` (calibration_job.h ReadNumericCsv) and selects the columns as SI rates.
 std::vector<Column> ReadColumns(const AllanCliOptions& options) {
-  const std::string file = options.data_path;
-  std::ifstream in(file);
-  if (!in) {
-    throw SpecError("DATA", file, "an existing, readable CSV file (open failed)");
-  }
-  std::string line;
-  size_t line_no = 0;
-  std::vector<std::string> header;
-  while (std::getline(in, line)) {
-    ++line_no;
-    const std::string_view t = Trim(line);
-    if (t.empty() || t.front() == '#') continue;
-    header = Split(t, ',');
-    break;
-  }
-  if (header.empty()) throw SpecError("DATA", file + " (empty)", "a header row and numeric rows");
-
-  // Column selection.
-  std::vector<Column> columns;
-  auto find = [&header](const std::string& name) -> long {
-    const auto it = std::find(header.begin(), header.end(), name);
-    return it == header.end() ? -1 : static_cast<long>(it - header.begin());
-  };
-  if (!options.columns.empty()) {
-    for (const std::string& name : Split(options.columns, ',')) {
-      const long index = find(name);
-      if (index < 0) {
-        throw SpecError("--columns", name.empty() ? "''" : "'" + name + "'",
-                        "a column of " + file + ": " + Join(header));
-      }
-      Column column;
-      column.name = name;
-      column.index = static_cast<size_t>(index);
-      columns.push_back(std::move(column));
-    }
-  } else {
-    const std::vector<std::string> imu = {"omega_x_rad_per_s", "omega_y_rad_per_s",
-                                          "omega_z_rad_per_s", "f_x_m_per_s2",
-                                          "f_y_m_per_s2",      "f_z_m_per_s2"};
-    const bool is_imu_csv =
-        std::all_of(imu.begin(), imu.end(), [&find](const std::string& n) { return find(n) >= 0; });
-    for (size_t i = 0; i < header.size(); ++i) {
-      const bool take = is_imu_csv ? std::find(imu.begin(), imu.end(), header[i]) != imu.end()
-                                   : !IsTimeColumn(header[i]);
-      if (!take) continue;
-      Column column;
-      column.name = header[i];
-      column.index = i;
-      columns.push_back(std::move(column));
-    }
-    if (columns.empty()) {
-      throw SpecError("DATA", file + " (only a time column)",
-                      "at least one column besides the time column");
-    }
-  }
-
-  // Units.
-  for (Column& column : columns) {
-    if (!options.unit.empty()) {
-      const Unit unit = ParseUnit(options.unit, "--unit");
-      if (!AcceptedDimension(unit.dimension)) {
-        throw SpecError("--unit", "'" + options.unit + "' (" + DimensionName(unit.dimension) + ")",
-                        kAllowedUnits);
-      }
-      SetUnit(column, options.unit, unit, options.rate_hz);
-    } else if (!UnitFromName(column, options.rate_hz)) {
-      throw SpecError(
-          "--unit", "missing",
-          fmt::format("a unit for column '{}' of {}: its name has no unit suffix (such as "
-                      "_rad_per_s, _deg_per_s, _deg_per_h, _m_per_s2, _g, _mg); give --unit as {}",
-                      column.name, file, kAllowedUnits));
-    }
-  }
-
-  // Rows.
-  while (std::getline(in, line)) {
-    ++line_no;
-    const std::string_view t = Trim(line);
-    if (t.empty() || t.front() == '#') continue;
-    const std::vector<std::string> fields = Split(t, ',');
-    if (fields.size() != header.size()) {
-      throw SpecError(fmt::format("{}:{}", file, line_no), fmt::format("{} fields", fields.size()),
-                      fmt::format("{} fields, as in the header", header.size()));
-    }
-    for (Column& column : columns) {
-      const std::string& text = fields[column.index];
-      double value = 0.0;
-      const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-      if (ec != std::errc() || ptr != text.data() + text.size() || !std::isfinite(value)) {
-        throw SpecError(fmt::format("{}:{}: column '{}'", file, line_no, column.name),
-                        "'" + text + "'", "a finite number");
-      }
-      column.samples.push_back(value * column.to_si);
-    }
-  }
-  for (const Column& column : columns) {
-    if (column.samples.size() < kMinSamples) {
-      throw SpecError(fmt::format("{}: column '{}'", file, column.name),
-                      fmt::format("{} samples", column.samples.size()),
-                      fmt::format("at least {} samples (two overlapping second differences at "
-                                  "tau = 1 / rate)",
-                                  kMinSamples));
-    }
-  }
-  return columns;
+  const jobspec::NumericTable table = jobspec::ReadNumericCsv(options.data_path);
+  return jobspec::SelectRateColumns(
+      table, options.columns.empty() ? std::vector<std::string>{} : SplitNames(options.columns),
+      options.unit, options.rate_hz, options.data_path, "--columns", "--unit");
 }
 
 const char* NoiseName(AllanNoiseType type) {
@@ -493,13 +319,26 @@ const RegisterCommand kAllan("allan", [](CLI::App& app) -> std::function<int()> 
                       "With --fit: flicker band start [s] (0 = first tau)");
   command->add_option("--flicker-tau-max", options->fit_options.flicker_tau_max_s,
                       "With --fit: flicker band end [s] (0 = last tau)");
+  command->add_option("--report", options->report_path,
+                      "With --fit: self-contained HTML report (ADEV with 95 % CIs and the fitted "
+                      "curve per column, fitted terms, the model)");
   return [options] {
-    if (!options->fit) return RunAllan(*options);
+    if (!options->fit) {
+      if (!options->report_path.empty()) {
+        fmt::print(stderr,
+                   "error: --report: {} is not allowed; allowed: with --fit (the report shows "
+                   "the noise-model fit)\n",
+                   options->report_path);
+        return kExitBadJob;
+      }
+      return RunAllan(*options);
+    }
     AllanFitOptions fit = options->fit_options;
     fit.data_path = options->data_path;
     fit.rate_hz = options->rate_hz;
     fit.columns = options->columns;
     fit.out_path = options->out_path;
+    fit.report_path = options->report_path;
     fit.points_per_octave = options->points_per_octave;
     if (!options->unit.empty()) {
       fmt::print(stderr,
