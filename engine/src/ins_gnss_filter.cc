@@ -7,6 +7,7 @@
 
 #include "driftlab/attitude.h"
 #include "driftlab/spec_error.h"
+#include "driftlab/trajectory.h"
 
 namespace driftlab {
 namespace {
@@ -52,64 +53,47 @@ void InsGnssFilter::SyncCovariance() {
   pending_ = 0;
 }
 
-void InsGnssFilter::Update(const GnssMeasurement& fix, const Vector3d& omega_ib_b) {
-  SyncCovariance();
-  const NavState& s = ins_.state();
+GnssUpdateModel MakeGnssUpdateModel(const NavEnvironment& env, const GnssConfig& g,
+                                    const NavState& s, const Vector3d& omega_ib_b) {
+  GnssUpdateModel m;
   const Matrix3d C = s.C_b_n();
-  const Vector3d& l = options_.gnss.lever_arm_b_m;
-  const Vector3d l_n = C * l;
-  const int m = options_.gnss.use_velocity ? 6 : 3;
-  Eigen::Matrix<double, 6, 1> z = Eigen::Matrix<double, 6, 1>::Zero();
-  Eigen::Matrix<double, 6, kNumErrorStates> H = Eigen::Matrix<double, 6, kNumErrorStates>::Zero();
-  Eigen::Matrix<double, 6, 6> R = Eigen::Matrix<double, 6, 6>::Zero();
-  // Position: estimated antenna minus fix, metres NED at the fix.
-  z.head<3>() = env_.PositionErrorNed(s.llh, fix.llh) + l_n;
-  H.block<3, 3>(0, kErrPosition) = Matrix3d::Identity();
-  H.block<3, 3>(0, kErrAttitude) = -Skew(l_n);
-  const GnssConfig& g = options_.gnss;
+  const Vector3d& l = g.lever_arm_b_m;
+  m.lever_n = C * l;
+  m.dim = g.use_velocity ? 6 : 3;
+  // Position rows: H_r = [I, 0, -[(C_b_n l_b) x], 0, 0] (Groves section 14.3.1, x = est - truth).
+  m.H.block<3, 3>(0, kErrPosition) = Matrix3d::Identity();
+  m.H.block<3, 3>(0, kErrAttitude) = -Skew(m.lever_n);
   for (int i = 0; i < 3; ++i) {
-    R(i, i) = g.position_sigma_ned_m[i] * g.position_sigma_ned_m[i] +
-              g.position_gauss_markov_sigma_ned_m[i] * g.position_gauss_markov_sigma_ned_m[i];
+    m.R(i, i) = g.position_sigma_ned_m[i] * g.position_sigma_ned_m[i] +
+                g.position_gauss_markov_sigma_ned_m[i] * g.position_gauss_markov_sigma_ned_m[i];
   }
-  if (m == 6) {
-    const Vector3d w = omega_ib_b - gyro_bias_;
-    const Vector3d v_lever = C * w.cross(l) - env_.EarthRate(s.llh.lat_rad).cross(l_n);
-    z.tail<3>() = s.v_eb_n + v_lever - fix.v_eb_n;
-    H.block<3, 3>(3, kErrVelocity) = Matrix3d::Identity();
-    H.block<3, 3>(3, kErrAttitude) = -Skew(C * w.cross(l));
-    H.block<3, 3>(3, kErrGyroBias) = -C * Skew(l);
+  if (m.dim == 6) {
+    const Vector3d w_x_l = C * omega_ib_b.cross(l);
+    m.lever_velocity_n = w_x_l - env.EarthRate(s.llh.lat_rad).cross(m.lever_n);
+    m.H.block<3, 3>(3, kErrVelocity) = Matrix3d::Identity();
+    m.H.block<3, 3>(3, kErrAttitude) = -Skew(w_x_l);
+    m.H.block<3, 3>(3, kErrGyroBias) = -C * Skew(l);
     for (int i = 0; i < 3; ++i) {
-      R(3 + i, 3 + i) = g.velocity_sigma_ned_m_per_s[i] * g.velocity_sigma_ned_m_per_s[i];
+      m.R(3 + i, 3 + i) = g.velocity_sigma_ned_m_per_s[i] * g.velocity_sigma_ned_m_per_s[i];
     }
   }
-  ErrorStateMatrix& P = propagator_.mutable_P();
-  ErrorStateVector x;
-  if (m == 6) {
-    const Eigen::Matrix<double, 6, 6> S = H * P * H.transpose() + R;
-    const Eigen::LLT<Eigen::Matrix<double, 6, 6>> llt(S);
-    const Eigen::Matrix<double, kNumErrorStates, 6> K =
-        llt.solve(H * P.transpose()).transpose();  // P H^T S^-1 (P, S symmetric)
-    x = K * z;
-    last_nis_ = z.dot(llt.solve(z));
-    const ErrorStateMatrix IKH = ErrorStateMatrix::Identity() - K * H;
-    P = IKH * P * IKH.transpose() + K * R * K.transpose();
-  } else {
-    const Eigen::Matrix<double, 3, kNumErrorStates> H3 = H.topRows<3>();
-    const Eigen::Matrix3d R3 = R.topLeftCorner<3, 3>();
-    const Eigen::Vector3d z3 = z.head<3>();
-    const Eigen::Matrix3d S = H3 * P * H3.transpose() + R3;
-    const Eigen::LLT<Eigen::Matrix3d> llt(S);
-    const Eigen::Matrix<double, kNumErrorStates, 3> K = llt.solve(H3 * P).transpose();
-    x = K * z3;
-    last_nis_ = z3.dot(llt.solve(z3));
-    const ErrorStateMatrix IKH = ErrorStateMatrix::Identity() - K * H3;
-    P = IKH * P * IKH.transpose() + K * R3 * K.transpose();
-  }
-  P = 0.5 * (P + P.transpose()).eval();
-  last_dim_ = m;
+  return m;
+}
+
+template <int M>
+void InsGnssFilter::Correct(const Eigen::Matrix<double, M, kNumErrorStates>& H,
+                            const Eigen::Matrix<double, M, M>& R,
+                            const Eigen::Matrix<double, M, 1>& z) {
+  Eigen::LLT<Eigen::Matrix<double, M, M>> llt;
+  const Eigen::Matrix<double, kNumErrorStates, M> K =
+      JosephUpdate<M>(H, R, &propagator_.mutable_P(), &llt);
+  const ErrorStateVector x = K * z;
+  last_nis_ = z.dot(llt.solve(z));
+  last_dim_ = M;
 
   // Closed-loop correction (truth = estimate - error).
-  NavState c = s;
+  NavState c = ins_.state();
+  const Matrix3d C = c.C_b_n();
   const double L = c.llh.lat_rad, h = c.llh.h_m;
   c.llh.lat_rad -= x[0] / (env_.MeridianRadiusAt(L) + h);
   c.llh.lon_rad -= x[1] / ((env_.TransverseRadiusAt(L) + h) * std::cos(L));
@@ -120,6 +104,135 @@ void InsGnssFilter::Update(const GnssMeasurement& fix, const Vector3d& omega_ib_
   accel_bias_ += x.segment<3>(kErrAccelBias);
   gyro_bias_ += x.segment<3>(kErrGyroBias);
   ins_ = NedMechanization(env_, c, dt_s_, options_.mechanization);
+}
+
+void InsGnssFilter::Update(const GnssMeasurement& fix, const Vector3d& omega_ib_b) {
+  SyncCovariance();
+  const NavState& s = ins_.state();
+  const GnssUpdateModel m = MakeGnssUpdateModel(env_, options_.gnss, s, omega_ib_b - gyro_bias_);
+  // Innovation: estimated antenna minus fix (position in metres NED at the fix).
+  Eigen::Matrix<double, 6, 1> z;
+  z.head<3>() = env_.PositionErrorNed(s.llh, fix.llh) + m.lever_n;
+  if (m.dim == 6) {
+    z.tail<3>() = s.v_eb_n + m.lever_velocity_n - fix.v_eb_n;
+    Correct<6>(m.H, m.R, z);
+  } else {
+    const Eigen::Matrix<double, 3, kNumErrorStates> H3 = m.H.topRows<3>();
+    const Eigen::Matrix3d R3 = m.R.topLeftCorner<3, 3>();
+    const Eigen::Vector3d z3 = z.head<3>();
+    Correct<3>(H3, R3, z3);
+  }
+}
+
+void InsGnssFilter::UpdateHeight(double h_m, double sigma_m) {
+  SyncCovariance();
+  Eigen::Matrix<double, 1, kNumErrorStates> H = Eigen::Matrix<double, 1, kNumErrorStates>::Zero();
+  H(0, kErrPosition + 2) = 1.0;
+  // z = (estimated down) - (measured down) = h_baro - h^ = dr_D + noise.
+  const Eigen::Matrix<double, 1, 1> z(h_m - ins_.state().llh.h_m);
+  const Eigen::Matrix<double, 1, 1> R(sigma_m * sigma_m);
+  Correct<1>(H, R, z);
+}
+
+void InsGnssFilter::UpdateZeroVelocity(double sigma_m_per_s, const Vector3d& v_measured_n) {
+  SyncCovariance();
+  Eigen::Matrix<double, 3, kNumErrorStates> H = Eigen::Matrix<double, 3, kNumErrorStates>::Zero();
+  H.block<3, 3>(0, kErrVelocity) = Matrix3d::Identity();
+  const Eigen::Matrix3d R = Matrix3d::Identity() * (sigma_m_per_s * sigma_m_per_s);
+  const Eigen::Vector3d z = ins_.state().v_eb_n - v_measured_n;
+  Correct<3>(H, R, z);
+}
+
+std::vector<CovarianceEpoch> FilterCovarianceAnalysis(
+    const MotionSpec& motion, double rate_hz, const ErrorStateNoise& noise,
+    const ErrorStateMatrix& P0, const AidingSpec* aiding, const std::vector<int64_t>& zupt_epochs,
+    const std::vector<int64_t>& epoch_samples, int64_t step_samples, Discretization method) {
+  if (step_samples < 1 || step_samples > 10000) {
+    throw SpecError("monte_carlo.covariance_step_samples", std::to_string(step_samples),
+                    "[1, 10000]");
+  }
+  TrajectoryGenerator generator(motion, rate_hz);
+  const NavEnvironment& env = generator.environment();
+  const double dt = generator.dt_s();
+  ErrorCovariancePropagator prop(env, noise, P0, method);
+  const GnssConfig* gnss = aiding != nullptr && aiding->gnss ? &*aiding->gnss : nullptr;
+  const BarometerConfig* baro =
+      aiding != nullptr && aiding->barometer ? &*aiding->barometer : nullptr;
+  const ZuptConfig* zupt = aiding != nullptr && aiding->zupt ? &*aiding->zupt : nullptr;
+  const int64_t gnss_dec =
+      gnss ? AidingDecimation(gnss->rate_hz, rate_hz, "aiding.gnss.rate_hz") : 0;
+  const int64_t baro_dec =
+      baro ? AidingDecimation(baro->rate_hz, rate_hz, "aiding.barometer.rate_hz") : 0;
+  Eigen::Matrix<double, 1, kNumErrorStates> H_baro =
+      Eigen::Matrix<double, 1, kNumErrorStates>::Zero();
+  H_baro(0, kErrPosition + 2) = 1.0;
+  Eigen::Matrix<double, 1, 1> R_baro = Eigen::Matrix<double, 1, 1>::Zero();
+  if (baro) {
+    R_baro(0, 0) = baro->noise_sigma_m * baro->noise_sigma_m + baro->bias.sigma * baro->bias.sigma;
+  }
+  Eigen::Matrix<double, 3, kNumErrorStates> H_zupt =
+      Eigen::Matrix<double, 3, kNumErrorStates>::Zero();
+  H_zupt.block<3, 3>(0, kErrVelocity) = Matrix3d::Identity();
+  const double zupt_var = zupt ? zupt->velocity_sigma_m_per_s * zupt->velocity_sigma_m_per_s : 0.0;
+  const Eigen::Matrix3d R_zupt = Matrix3d::Identity() * zupt_var;
+  auto in_outage = [gnss](double t_s) {
+    for (const GnssOutage& o : gnss->outages) {
+      if (t_s >= o.start_s && t_s < o.start_s + o.duration_s) return true;
+    }
+    return false;
+  };
+
+  std::vector<CovarianceEpoch> out;
+  out.reserve(epoch_samples.size());
+  size_t next_epoch = 0, next_zupt = 0;
+  const NavState& truth0 = generator.initial_state();
+  if (next_epoch < epoch_samples.size() && epoch_samples[next_epoch] == 0) {
+    out.push_back(MakeCovarianceEpoch(truth0.t_s, prop.P(), truth0.euler()));
+    ++next_epoch;
+  }
+  Matrix3d C_prev = truth0.C_b_n();
+  Vector3d f_n_sum = Vector3d::Zero();
+  int64_t pending = 0;
+  TrajectorySample sample;
+  while (generator.Next(&sample)) {
+    const int64_t k = generator.step();
+    const NavState& truth = sample.truth;
+    const Matrix3d C = truth.C_b_n();
+    f_n_sum += 0.5 * (C_prev + C) * sample.increment.delta_v_ib_b;
+    C_prev = C;
+    ++pending;
+    const bool epoch = next_epoch < epoch_samples.size() && epoch_samples[next_epoch] == k;
+    while (next_zupt < zupt_epochs.size() && zupt_epochs[next_zupt] < k) ++next_zupt;
+    const bool gnss_now = gnss && k % gnss_dec == 0 && !in_outage(truth.t_s);
+    const bool baro_now = baro && k % baro_dec == 0;
+    const bool zupt_now = zupt && next_zupt < zupt_epochs.size() && zupt_epochs[next_zupt] == k;
+    if (pending >= step_samples || epoch || gnss_now || baro_now || zupt_now) {
+      // As InsGnssFilter::SyncCovariance: F at the state at the end of the interval with the
+      // interval's mean specific force resolved in its body frame.
+      const double T = static_cast<double>(pending) * dt;
+      prop.Propagate(truth, C.transpose() * (f_n_sum / T), T);
+      f_n_sum.setZero();
+      pending = 0;
+    }
+    if (epoch) {
+      out.push_back(MakeCovarianceEpoch(truth.t_s, prop.P(), truth.euler()));
+      ++next_epoch;
+    }
+    if (gnss_now) {
+      const Vector3d omega_ib_b = sample.increment.delta_theta_ib_b / dt;
+      const GnssUpdateModel m = MakeGnssUpdateModel(env, *gnss, truth, omega_ib_b);
+      if (m.dim == 6) {
+        JosephUpdate<6>(m.H, m.R, &prop.mutable_P());
+      } else {
+        const Eigen::Matrix<double, 3, kNumErrorStates> H3 = m.H.topRows<3>();
+        const Eigen::Matrix3d R3 = m.R.topLeftCorner<3, 3>();
+        JosephUpdate<3>(H3, R3, &prop.mutable_P());
+      }
+    }
+    if (baro_now) JosephUpdate<1>(H_baro, R_baro, &prop.mutable_P());
+    if (zupt_now) JosephUpdate<3>(H_zupt, R_zupt, &prop.mutable_P());
+  }
+  return out;
 }
 
 double Nees(const ErrorStateVector& error, const ErrorStateMatrix& P) {

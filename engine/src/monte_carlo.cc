@@ -19,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include "driftlab/ins_gnss_filter.h"
 #include "driftlab/random.h"
 #include "driftlab/sensors.h"
 #include "driftlab/spec_error.h"
@@ -82,6 +83,17 @@ struct SharedTruth {
   // Truth-height aiding: h and v_D at every sample.
   std::vector<double> h_m, v_D_m_per_s;
   std::vector<Report> reports;  // ascending k, all >= start_step
+  // Aiding: truth at the GNSS epochs j (sample j * gnss_decimation) and the ideal body rate there;
+  // truth height at the barometer epochs; truth attitude at the magnetometer epochs; ZUPT samples.
+  int64_t gnss_decimation = 0, baro_decimation = 0, mag_decimation = 0;
+  std::vector<NavState> gnss_truth;
+  std::vector<Vector3d> gnss_omega_ib_b;
+  std::vector<double> baro_h_m;
+  std::vector<Quaterniond> mag_q_b_n;
+  std::vector<int64_t> zupt_epochs;
+  // kInsGnssEkf: the filter's noise model and initial covariance.
+  ErrorStateNoise ekf_noise;
+  ErrorStateMatrix ekf_P0 = ErrorStateMatrix::Zero();
 };
 
 // Converts requested times into ascending sample indices in [first_k, n].
@@ -107,6 +119,93 @@ std::vector<int64_t> SnapTimes(const std::vector<double>& times_s, const std::st
     out.push_back(k);
   }
   return out;
+}
+
+const char* FilterName(NavigationFilterKind f) {
+  switch (f) {
+    case NavigationFilterKind::kNone:
+      return "NONE";
+    case NavigationFilterKind::kInsGnssEkf:
+      return "INS_GNSS_EKF";
+    case NavigationFilterKind::kComplementary:
+      return "COMPLEMENTARY";
+  }
+  return "?";
+}
+
+// The filter, the aiding and the covariance analysis fit together and with the navigation.
+void ValidateFilter(const MonteCarloSpec& spec) {
+  const NavigationFilterKind f = spec.filter;
+  const std::string name = FilterName(f);
+  const bool seed000 = spec.simulation.mechanization == MechanizationKind::kSeed000;
+  const bool truth_plus = spec.initialization == InitializationKind::kTruthPlusErrors;
+  const bool free_vertical = spec.simulation.ned.vertical == VerticalChannel::kFree;
+  const AidingSpec& a = spec.aiding;
+  if (f != NavigationFilterKind::kNone) {
+    if (seed000) {
+      throw SpecError("navigation.filter", name,
+                      "NONE with mechanization SEED000 (filters run on mechanization NED)");
+    }
+    if (!truth_plus) {
+      throw SpecError("monte_carlo.initialization.kind", "STATIC_ALIGNMENT",
+                      "TRUTH_PLUS_ERRORS with navigation.filter " + name);
+    }
+  }
+  const auto only_with = [&](bool present, const std::string& field, const std::string& filter) {
+    if (present && name != filter) {
+      throw SpecError(field, "set",
+                      "only with navigation.filter " + filter + " (the filter is " + name + ")");
+    }
+  };
+  only_with(a.gnss.has_value(), "aiding.gnss", "INS_GNSS_EKF");
+  only_with(a.barometer.has_value(), "aiding.barometer", "INS_GNSS_EKF");
+  only_with(a.zupt.has_value(), "aiding.zupt", "INS_GNSS_EKF");
+  only_with(a.magnetometer.has_value(), "aiding.magnetometer", "COMPLEMENTARY");
+  if (f == NavigationFilterKind::kInsGnssEkf) {
+    if (!a.gnss && !a.barometer && !a.zupt) {
+      throw SpecError("navigation.filter", name,
+                      "INS_GNSS_EKF with at least one of aiding.gnss, aiding.barometer, "
+                      "aiding.zupt (an EKF without measurements is the free INS: use NONE)");
+    }
+    if (!free_vertical) {
+      throw SpecError("navigation.ned.vertical_channel", "TRUTH_HEIGHT",
+                      "FREE with navigation.filter INS_GNSS_EKF (aid the height with "
+                      "aiding.barometer instead)");
+    }
+    if (spec.ekf_propagation_step_samples < 1 || spec.ekf_propagation_step_samples > 10000) {
+      throw SpecError("navigation.ekf.propagation_step_samples",
+                      std::to_string(spec.ekf_propagation_step_samples), "[1, 10000]");
+    }
+  }
+  if (f == NavigationFilterKind::kComplementary) {
+    const InitialErrorSigmas& e = spec.initial_errors;
+    if (!e.position_ned_m.isZero(0.0) || !e.velocity_ned_m_per_s.isZero(0.0)) {
+      throw SpecError("monte_carlo.initial_errors", "non-zero position or velocity sigma",
+                      "zero with navigation.filter COMPLEMENTARY (it estimates attitude only)");
+    }
+    if (e.attitude_rad.x() != 0.0 || e.attitude_rad.y() != 0.0) {
+      throw SpecError("monte_carlo.initial_errors.attitude_rad", "non-zero roll or pitch sigma",
+                      "zero roll and pitch with navigation.filter COMPLEMENTARY (it levels from "
+                      "the accelerometer; only the initial yaw error is used)");
+    }
+    const double rate = spec.simulation.rate_hz;
+    DesignComplementaryPair(spec.complementary.kind, spec.complementary.crossover_hz, rate,
+                            "navigation.complementary.crossover_hz", "rate_hz");
+    DesignComplementaryPair(spec.complementary.kind, spec.complementary.heading_crossover_hz, rate,
+                            "navigation.complementary.heading_crossover_hz", "rate_hz");
+  }
+  if (spec.covariance) {
+    if (seed000 || !truth_plus || !free_vertical || f == NavigationFilterKind::kComplementary) {
+      throw SpecError("monte_carlo.covariance", "true",
+                      "false unless mechanization NED, vertical channel FREE, initialization "
+                      "TRUTH_PLUS_ERRORS and filter NONE or INS_GNSS_EKF (the 15-state error "
+                      "model describes those)");
+    }
+    if (spec.covariance_step_samples < 1 || spec.covariance_step_samples > 10000) {
+      throw SpecError("monte_carlo.covariance_step_samples",
+                      std::to_string(spec.covariance_step_samples), "[1, 10000]");
+    }
+  }
 }
 
 // Validates the Monte-Carlo fields that do not need the trajectory.
@@ -180,10 +279,12 @@ void ValidateSpec(const MonteCarloSpec& spec) {
                       "alignment)");
     }
   }
+  ValidateFilter(spec);
 }
 
-// Generates the truth once and keeps what the runs need.
-SharedTruth BuildSharedTruth(const MonteCarloSpec& spec) {
+// Generates the truth once and keeps what the runs need (without keep_imu: only the layout, the
+// reports and the start state, for ReplayMonteCarloRun).
+SharedTruth BuildSharedTruth(const MonteCarloSpec& spec, bool keep_imu = true) {
   TrajectoryGenerator generator(spec.simulation.motion, spec.simulation.rate_hz);
   SharedTruth s;
   s.env = generator.environment();
@@ -267,13 +368,41 @@ SharedTruth BuildSharedTruth(const MonteCarloSpec& spec) {
     s.reports.push_back(r);
   }
 
+  // Aiding: validated against the IMU rate and the trajectory's duration.
+  ValidateAidingSpec(spec.aiding, s.rate_hz, generator.duration_s());
+  const AidingSpec& aiding = spec.aiding;
+  if (keep_imu && aiding.gnss) {
+    s.gnss_decimation = AidingDecimation(aiding.gnss->rate_hz, s.rate_hz, "aiding.gnss.rate_hz");
+    s.gnss_truth.resize(static_cast<size_t>(s.n / s.gnss_decimation) + 1);
+    s.gnss_omega_ib_b.resize(s.gnss_truth.size(), Vector3d::Zero());
+    s.gnss_truth[0] = s.truth0;
+  }
+  if (keep_imu && aiding.barometer) {
+    s.baro_decimation =
+        AidingDecimation(aiding.barometer->rate_hz, s.rate_hz, "aiding.barometer.rate_hz");
+    s.baro_h_m.resize(static_cast<size_t>(s.n / s.baro_decimation) + 1);
+    s.baro_h_m[0] = s.truth0.llh.h_m;
+  }
+  if (keep_imu && aiding.magnetometer) {
+    s.mag_decimation =
+        AidingDecimation(aiding.magnetometer->rate_hz, s.rate_hz, "aiding.magnetometer.rate_hz");
+    s.mag_q_b_n.resize(static_cast<size_t>(s.n / s.mag_decimation) + 1);
+    s.mag_q_b_n[0] = s.truth0.q_b_n;
+  }
+  if (keep_imu && aiding.zupt) {
+    s.zupt_epochs = ZuptEpochs(*aiding.zupt, s.rate_hz, s.start_step + 1, s.n,
+                               [&](double t) { return generator.IsStaticAt(t); });
+  }
+  // Point samples for mechanization B and the complementary filter, increments otherwise.
+  const bool point_samples = seed000 || spec.filter == NavigationFilterKind::kComplementary;
+
   // Stream the trajectory once.
   const bool truth_height =
-      !seed000 && spec.simulation.ned.vertical == VerticalChannel::kTruthHeight;
-  if (seed000) {
+      keep_imu && !seed000 && spec.simulation.ned.vertical == VerticalChannel::kTruthHeight;
+  if (keep_imu && point_samples) {
     s.samples.resize(static_cast<size_t>(s.n) + 1);
     s.samples[0] = generator.initial_sample();
-  } else {
+  } else if (keep_imu) {
     s.increments.resize(static_cast<size_t>(s.n) + 1);
   }
   if (truth_height) {
@@ -294,10 +423,21 @@ SharedTruth BuildSharedTruth(const MonteCarloSpec& spec) {
   while (generator.Next(&sample)) {
     const int64_t k = generator.step();
     const size_t uk = static_cast<size_t>(k);
-    if (seed000) {
+    if (keep_imu && point_samples) {
       s.samples[uk] = sample.sample;
-    } else {
+    } else if (keep_imu) {
       s.increments[uk] = sample.increment;
+    }
+    if (s.gnss_decimation > 0 && k % s.gnss_decimation == 0) {
+      const size_t j = static_cast<size_t>(k / s.gnss_decimation);
+      s.gnss_truth[j] = sample.truth;
+      s.gnss_omega_ib_b[j] = sample.increment.delta_theta_ib_b / s.dt_s;
+    }
+    if (s.baro_decimation > 0 && k % s.baro_decimation == 0) {
+      s.baro_h_m[static_cast<size_t>(k / s.baro_decimation)] = sample.truth.llh.h_m;
+    }
+    if (s.mag_decimation > 0 && k % s.mag_decimation == 0) {
+      s.mag_q_b_n[static_cast<size_t>(k / s.mag_decimation)] = sample.truth.q_b_n;
     }
     if (truth_height) {
       s.h_m[uk] = sample.truth.llh.h_m;
@@ -430,6 +570,43 @@ NavState PerturbedStart(const SharedTruth& s, const MonteCarloSpec& spec, uint32
   return init;
 }
 
+// Mechanization A's state at navigation start s0 for `run`: the truth at s0 plus the run's
+// position and velocity errors, with the attitude from the static alignment (sum_dtheta, sum_dv:
+// the measured increments summed over the window, k = 1..s0) or the truth's plus the attitude
+// errors.
+NavState NedStartState(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run,
+                       bool gyrocompass, const Eigen::Vector3d& sum_dtheta,
+                       const Eigen::Vector3d& sum_dv) {
+  NavState init = PerturbedStart(s, spec, run);
+  if (spec.initialization == InitializationKind::kStaticAlignment) {
+    const double T = static_cast<double>(s.start_step) * s.dt_s;
+    const Eigen::Vector3d f = sum_dv / T;
+    const Eigen::Vector3d w = sum_dtheta / T;
+    EulerAngles e;
+    e.roll_rad = std::atan2(-f.y(), -f.z());
+    e.pitch_rad = std::atan(f.x() / std::hypot(f.y(), f.z()));
+    if (gyrocompass) {
+      const double sr = std::sin(e.roll_rad), cr = std::cos(e.roll_rad);
+      const double sp = std::sin(e.pitch_rad), cp = std::cos(e.pitch_rad);
+      e.yaw_rad = std::atan2(-w.y() * cr + w.z() * sr, w.x() * cp + (w.y() * sr + w.z() * cr) * sp);
+    } else {
+      const Eigen::Vector3d heading_sigma(0.0, 0.0, *spec.alignment.heading_sigma_rad);
+      e.yaw_rad = WrapPi(s.truth_start.euler().yaw_rad +
+                         InitialErrorDraw(spec.seed, run, 3, heading_sigma).z());
+    }
+    init.q_b_n = Quaterniond(EulerToDcm(e));
+  } else {
+    EulerAngles e = s.truth_start.euler();
+    const Eigen::Vector3d da =
+        InitialErrorDraw(spec.seed, run, 2, spec.initial_errors.attitude_rad);
+    e.roll_rad += da.x();
+    e.pitch_rad += da.y();
+    e.yaw_rad += da.z();
+    init.q_b_n = Quaterniond(EulerToDcm(e));
+  }
+  return init;
+}
+
 // Runs one run with mechanization A. Returns false if stopped early.
 bool RunNed(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, bool gyrocompass,
             const RunSink& sink, Monitor* monitor, int64_t* samples) {
@@ -465,35 +642,8 @@ bool RunNed(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, bool
     }
   }
 
-  NavState init = PerturbedStart(s, spec, run);
-  if (spec.initialization == InitializationKind::kStaticAlignment) {
-    const double T = static_cast<double>(s.start_step) * s.dt_s;
-    const Eigen::Vector3d f = sum_dv / T;
-    const Eigen::Vector3d w = sum_dtheta / T;
-    EulerAngles e;
-    e.roll_rad = std::atan2(-f.y(), -f.z());
-    e.pitch_rad = std::atan(f.x() / std::hypot(f.y(), f.z()));
-    if (gyrocompass) {
-      const double sr = std::sin(e.roll_rad), cr = std::cos(e.roll_rad);
-      const double sp = std::sin(e.pitch_rad), cp = std::cos(e.pitch_rad);
-      e.yaw_rad = std::atan2(-w.y() * cr + w.z() * sr, w.x() * cp + (w.y() * sr + w.z() * cr) * sp);
-    } else {
-      const Eigen::Vector3d heading_sigma(0.0, 0.0, *spec.alignment.heading_sigma_rad);
-      e.yaw_rad = WrapPi(s.truth_start.euler().yaw_rad +
-                         InitialErrorDraw(spec.seed, run, 3, heading_sigma).z());
-    }
-    init.q_b_n = Quaterniond(EulerToDcm(e));
-  } else {
-    EulerAngles e = s.truth_start.euler();
-    const Eigen::Vector3d da =
-        InitialErrorDraw(spec.seed, run, 2, spec.initial_errors.attitude_rad);
-    e.roll_rad += da.x();
-    e.pitch_rad += da.y();
-    e.yaw_rad += da.z();
-    init.q_b_n = Quaterniond(EulerToDcm(e));
-  }
-
-  NedMechanization ned(s.env, init, s.dt_s, spec.simulation.ned);
+  NedMechanization ned(s.env, NedStartState(s, spec, run, gyrocompass, sum_dtheta, sum_dv), s.dt_s,
+                       spec.simulation.ned);
   size_t next = 0;
   const size_t n_reports = s.reports.size();
   if (s.reports[0].k == s.start_step) {
@@ -555,6 +705,176 @@ bool RunSeed000(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, 
   return true;
 }
 
+// Per-thread NEES sums of a kInsGnssEkf job (FilterConsistencyData), indexed by epoch.
+struct NeesAccumulator {
+  std::vector<ExactSum> sum;
+  std::vector<uint64_t> count;
+};
+
+// Runs one run with the INS/GNSS EKF (mechanization A, kTruthPlusErrors). Returns false if
+// stopped early. At a sample: predict, report (after propagating P to the sample at an epoch),
+// then the GNSS, barometer and ZUPT updates due at that sample, in this order (as
+// FilterCovarianceAnalysis).
+bool RunEkf(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, const RunSink& sink,
+            NeesAccumulator* nees, Monitor* monitor, int64_t* samples) {
+  std::optional<ImuErrorSimulator> sim;
+  if (spec.sensor) sim.emplace(*spec.sensor, spec.seed, run, s.rate_hz);
+  const AidingSpec& aiding = spec.aiding;
+  InsGnssFilterOptions options;
+  options.imu_noise = s.ekf_noise;
+  if (aiding.gnss) {
+    options.gnss = *aiding.gnss;
+  } else {
+    options.gnss.rate_hz = s.rate_hz;  // unused; valid for any IMU rate
+  }
+  options.propagation_step_samples = spec.ekf_propagation_step_samples;
+  options.mechanization = spec.simulation.ned;
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  InsGnssFilter filter(s.env, NedStartState(s, spec, run, true, zero, zero), s.ekf_P0, s.rate_hz,
+                       options);
+  std::optional<GnssSimulator> gnss;
+  if (aiding.gnss) gnss.emplace(*aiding.gnss, s.env, s.rate_hz, spec.seed, run);
+  std::optional<BarometerSimulator> baro;
+  double baro_sigma_m = 0.0;
+  if (aiding.barometer) {
+    baro.emplace(*aiding.barometer, s.rate_hz, spec.seed, run);
+    baro_sigma_m = std::hypot(aiding.barometer->noise_sigma_m, aiding.barometer->bias.sigma);
+  }
+  std::optional<ZuptSimulator> zupt;
+  if (aiding.zupt) zupt.emplace(*aiding.zupt, s.rate_hz, spec.seed, run);
+  size_t next_zupt = 0;
+
+  auto record = [&](const Report& r) {
+    if (r.epoch >= 0) filter.SyncCovariance();
+    const NavError error = ComputeNavError(s.env, filter.state(), r.truth);
+    sink.Record(r, error);
+    if (r.epoch < 0) return;
+    // NEES of the 9 navigation states against the filter's P (chi2(9) for a consistent filter).
+    Eigen::Matrix<double, 9, 1> e;
+    e << error.r_ned_m, error.v_ned_m_per_s, error.psi_nb_n_rad;
+    const Eigen::LLT<Eigen::Matrix<double, 9, 9>> llt(filter.P().topLeftCorner<9, 9>());
+    if (llt.info() != Eigen::Success) return;
+    const double value = e.dot(llt.solve(e));
+    if (!std::isfinite(value)) return;
+    nees->sum[static_cast<size_t>(r.epoch)].Add(value);
+    ++nees->count[static_cast<size_t>(r.epoch)];
+  };
+
+  size_t next = 0;
+  const size_t n_reports = s.reports.size();
+  if (s.reports[0].k == s.start_step) {
+    record(s.reports[0]);
+    next = 1;
+  }
+  ImuIncrement measured;
+  int64_t polled = 0;
+  for (int64_t k = s.start_step + 1; k <= s.n; ++k) {
+    const ImuIncrement& ideal = s.increments[static_cast<size_t>(k)];
+    if (sim) {
+      sim->Apply(ideal, &measured);
+    } else {
+      measured = ideal;
+    }
+    filter.Predict(measured);
+    if (next < n_reports && s.reports[next].k == k) record(s.reports[next++]);
+    if (gnss && k % s.gnss_decimation == 0) {
+      const size_t j = static_cast<size_t>(k / s.gnss_decimation);
+      GnssMeasurement fix;
+      if (gnss->Measure(k, s.gnss_truth[j], s.gnss_omega_ib_b[j], &fix)) {
+        filter.Update(fix, measured.delta_theta_ib_b / s.dt_s);
+      }
+    }
+    if (baro && k % s.baro_decimation == 0) {
+      double h_m = 0.0;
+      baro->Measure(k, s.baro_h_m[static_cast<size_t>(k / s.baro_decimation)], &h_m);
+      filter.UpdateHeight(h_m, baro_sigma_m);
+    }
+    if (next_zupt < s.zupt_epochs.size() && s.zupt_epochs[next_zupt] == k) {
+      filter.UpdateZeroVelocity(aiding.zupt->velocity_sigma_m_per_s, zupt->Measure(k));
+      ++next_zupt;
+    }
+    if ((k & (kPollSamples - 1)) == 0) {
+      const int64_t d = k - polled;
+      polled = k;
+      if (monitor->Poll(d)) {
+        *samples = 0;
+        return false;
+      }
+    }
+  }
+  *samples = s.n - polled;
+  return true;
+}
+
+// Runs one run with the complementary attitude filter on the measured point samples k = 0..n.
+// Returns false if stopped early.
+bool RunComplementary(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run,
+                      const RunSink& sink, Monitor* monitor, int64_t* samples) {
+  std::optional<ImuErrorSimulator> sim;
+  if (spec.sensor) sim.emplace(*spec.sensor, spec.seed, run, s.rate_hz);
+  ComplementaryFilterOptions options = spec.complementary;
+  std::optional<MagnetometerSimulator> mag;
+  if (spec.aiding.magnetometer) {
+    mag.emplace(*spec.aiding.magnetometer, s.rate_hz, spec.seed, run);
+    options.magnetic_declination_rad = MagneticDeclination(spec.aiding.magnetometer->earth_field_n);
+  }
+  options.initial_yaw_rad =
+      WrapPi(s.truth0.euler().yaw_rad +
+             InitialErrorDraw(spec.seed, run, 2, spec.initial_errors.attitude_rad).z());
+  ComplementaryAttitudeFilter filter(options, s.rate_hz);
+  ImuSample measured;
+  size_t next = 0;
+  const size_t n_reports = s.reports.size();
+  int64_t polled = 0;
+  for (int64_t k = 0; k <= s.n; ++k) {
+    const ImuSample& ideal = s.samples[static_cast<size_t>(k)];
+    if (sim) {
+      sim->Apply(ideal, &measured);
+    } else {
+      measured = ideal;
+    }
+    Eigen::Vector3d m_b;
+    const bool has_mag =
+        mag && k % s.mag_decimation == 0 &&
+        mag->Measure(k, s.mag_q_b_n[static_cast<size_t>(k / s.mag_decimation)].toRotationMatrix(),
+                     &m_b);
+    filter.Update(measured, has_mag ? &m_b : nullptr);
+    if (next < n_reports && s.reports[next].k == k) {
+      // Attitude only: position and velocity are the truth's (errors reported as 0).
+      NavState nav = s.reports[next].truth;
+      nav.q_b_n = Quaterniond(EulerToDcm(filter.attitude()));
+      sink.Record(s.reports[next], ComputeNavError(s.env, nav, s.reports[next].truth));
+      ++next;
+    }
+    if (k > 0 && (k & (kPollSamples - 1)) == 0) {
+      const int64_t d = k - polled;
+      polled = k;
+      if (monitor->Poll(d)) {
+        *samples = 0;
+        return false;
+      }
+    }
+  }
+  *samples = s.n + 1 - polled;
+  return true;
+}
+
+// Gyrocompass or external heading: one decision per job (it depends on the model only).
+bool UseGyrocompass(const MonteCarloSpec& spec, const SharedTruth& truth) {
+  const bool seed000 = spec.simulation.mechanization == MechanizationKind::kSeed000;
+  if (seed000 || spec.initialization != InitializationKind::kStaticAlignment ||
+      !spec.alignment.heading_sigma_rad) {
+    return true;
+  }
+  const double omega_ie = truth.env.model() == EarthModel::kFlat ? 0.0 : kWgs84EarthRate_rad_per_s;
+  const double predicted =
+      spec.sensor
+          ? PredictedGyrocompassHeadingSigma(spec.sensor->gyro, truth.truth_start.llh.lat_rad,
+                                             spec.alignment.duration_s, omega_ie)
+          : (omega_ie > 0.0 ? 0.0 : std::numeric_limits<double>::infinity());
+  return predicted < *spec.alignment.heading_sigma_rad;
+}
+
 }  // namespace
 
 double PredictedGyrocompassHeadingSigma(const TriadErrorParams& gyro, double L_b, double duration_s,
@@ -572,31 +892,55 @@ double PredictedGyrocompassHeadingSigma(const TriadErrorParams& gyro, double L_b
   return std::sqrt(bias2 + white2) / std::abs(horizontal_rate);
 }
 
+void ValidateFilterAndAiding(const MonteCarloSpec& spec) {
+  ValidateFilter(spec);
+  ValidateAidingSpec(spec.aiding, spec.simulation.rate_hz, -1.0);
+}
+
+void FilterConsistencyData::Merge(const FilterConsistencyData& other) {
+  if (other.nees_sum.size() != nees_sum.size() || other.nees_count.size() != nees_count.size()) {
+    throw SpecError("statistics.nees", std::to_string(other.nees_sum.size()) + " epochs",
+                    std::to_string(nees_sum.size()) + " epochs (the same job)");
+  }
+  for (size_t e = 0; e < nees_sum.size(); ++e) {
+    nees_sum[e].Merge(other.nees_sum[e]);
+    nees_count[e] += other.nees_count[e];
+  }
+}
+
 MonteCarloStatistics RunMonteCarlo(const MonteCarloSpec& spec,
                                    const std::function<void(const MonteCarloProgress&)>& progress,
                                    const std::atomic<bool>* cancel) {
+  MonteCarloSpec without_analysis = spec;
+  without_analysis.covariance = false;
+  return std::move(RunMonteCarloWithAnalysis(without_analysis, progress, cancel).statistics);
+}
+
+MonteCarloOutput RunMonteCarloWithAnalysis(
+    const MonteCarloSpec& spec, const std::function<void(const MonteCarloProgress&)>& progress,
+    const std::atomic<bool>* cancel) {
   const Clock::time_point start = Clock::now();
   ValidateSpec(spec);
   if (spec.sensor) ValidateImuErrorModel(*spec.sensor, "sensor");
   const uint32_t run_count = spec.run_count == 0 ? spec.runs - spec.first_run : spec.run_count;
 
-  const SharedTruth truth = BuildSharedTruth(spec);
+  SharedTruth shared = BuildSharedTruth(spec);
+  const bool ekf = spec.filter == NavigationFilterKind::kInsGnssEkf;
+  const bool complementary = spec.filter == NavigationFilterKind::kComplementary;
+  // The error-state model of the sensor (no sensor: no process noise, no bias uncertainty).
+  ErrorStateNoiseFromImu noise;
+  if (spec.sensor) noise = MakeErrorStateNoise(*spec.sensor);
+  if (ekf || spec.covariance) {
+    shared.ekf_noise = noise.noise;
+    shared.ekf_P0 = InitialErrorCovariance(
+        spec.initial_errors.position_ned_m, spec.initial_errors.velocity_ned_m_per_s,
+        spec.initial_errors.attitude_rad, shared.truth_start.euler(), noise.noise);
+  }
+  const SharedTruth& truth = shared;
   const double truth_s = Seconds(start);
   const bool seed000 = spec.simulation.mechanization == MechanizationKind::kSeed000;
 
-  // Gyrocompass or external heading: one decision per job (it depends on the model only).
-  bool gyrocompass = true;
-  if (!seed000 && spec.initialization == InitializationKind::kStaticAlignment &&
-      spec.alignment.heading_sigma_rad) {
-    const double omega_ie =
-        truth.env.model() == EarthModel::kFlat ? 0.0 : kWgs84EarthRate_rad_per_s;
-    const double predicted =
-        spec.sensor
-            ? PredictedGyrocompassHeadingSigma(spec.sensor->gyro, truth.truth_start.llh.lat_rad,
-                                               spec.alignment.duration_s, omega_ie)
-            : (omega_ie > 0.0 ? 0.0 : std::numeric_limits<double>::infinity());
-    gyrocompass = predicted < *spec.alignment.heading_sigma_rad;
-  }
+  const bool gyrocompass = UseGyrocompass(spec, truth);
 
   // Output buffers: per-run checkpoint values (each run writes its own slot), per-thread sums.
   size_t n_epochs = 0, n_checkpoints = 0;
@@ -613,8 +957,14 @@ MonteCarloStatistics RunMonteCarlo(const MonteCarloSpec& spec,
       n_checkpoints, std::vector<ErrorComponentValues>(run_count));
   const EpochAccumulator exemplar(n_epochs);
   tbb::enumerable_thread_specific<EpochAccumulator> accumulators(exemplar);
+  NeesAccumulator nees_exemplar;
+  if (ekf) {
+    nees_exemplar.sum.resize(n_epochs);
+    nees_exemplar.count.assign(n_epochs, 0);
+  }
+  tbb::enumerable_thread_specific<NeesAccumulator> nees_accumulators(nees_exemplar);
 
-  const int64_t samples_per_run = seed000 ? truth.n + 1 : truth.n;
+  const int64_t samples_per_run = seed000 || complementary ? truth.n + 1 : truth.n;
   Monitor monitor(progress, cancel, run_count, samples_per_run * int64_t{run_count}, start);
   const int threads = spec.threads > 0 ? spec.threads : tbb::info::default_concurrency();
   tbb::task_arena arena(threads);
@@ -629,10 +979,17 @@ MonteCarloStatistics RunMonteCarlo(const MonteCarloSpec& spec,
                           sink.slot = slot;
                           const uint32_t run = spec.first_run + slot;
                           int64_t samples = 0;
-                          const bool done =
-                              seed000
-                                  ? RunSeed000(truth, spec, run, sink, &monitor, &samples)
-                                  : RunNed(truth, spec, run, gyrocompass, sink, &monitor, &samples);
+                          bool done = false;
+                          if (seed000) {
+                            done = RunSeed000(truth, spec, run, sink, &monitor, &samples);
+                          } else if (ekf) {
+                            done = RunEkf(truth, spec, run, sink, &nees_accumulators.local(),
+                                          &monitor, &samples);
+                          } else if (complementary) {
+                            done = RunComplementary(truth, spec, run, sink, &monitor, &samples);
+                          } else {
+                            done = RunNed(truth, spec, run, gyrocompass, sink, &monitor, &samples);
+                          }
                           if (!done) return;
                           monitor.RunDone(samples);
                         }
@@ -644,11 +1001,13 @@ MonteCarloStatistics RunMonteCarlo(const MonteCarloSpec& spec,
   data.job_runs = spec.runs;
   data.timings.truth_s = truth_s;
   data.timings.threads = threads;
+  MonteCarloOutput output;
   if (monitor.Stopped()) {
     data.cancelled = true;
     data.timings.samples_processed = monitor.samples_done();
     data.timings.wall_s = Seconds(start);
-    return MonteCarloStatistics(std::move(data));
+    output.statistics = MonteCarloStatistics(std::move(data));
+    return output;
   }
   monitor.ReportFinal();
 
@@ -674,9 +1033,160 @@ MonteCarloStatistics RunMonteCarlo(const MonteCarloSpec& spec,
       data.checkpoints.push_back(std::move(cp));
     }
   }
+  if (ekf) {
+    FilterConsistencyData consistency;
+    consistency.nees_sum.resize(n_epochs);
+    consistency.nees_count.assign(n_epochs, 0);
+    for (const NeesAccumulator& local : nees_accumulators) {
+      for (size_t e = 0; e < n_epochs; ++e) {
+        consistency.nees_sum[e].Merge(local.sum[e]);
+        consistency.nees_count[e] += local.count[e];
+      }
+    }
+    output.consistency = std::move(consistency);
+  }
+  if (spec.covariance) {
+    // The analysis at the epochs' samples, the ZUPT epochs as the runs use them.
+    std::vector<int64_t> epoch_samples;
+    for (const Report& r : truth.reports) {
+      if (r.epoch >= 0) epoch_samples.push_back(r.k);
+    }
+    CovarianceAnalysisResult analysis;
+    analysis.filter = spec.filter;
+    analysis.step_samples = ekf ? spec.ekf_propagation_step_samples : spec.covariance_step_samples;
+    analysis.unrepresented = noise.unrepresented;
+    if (ekf && spec.aiding.gnss && !spec.aiding.gnss->position_gauss_markov_sigma_ned_m.isZero()) {
+      analysis.unrepresented.push_back("aiding.gnss.position_gauss_markov_sigma_ned_m");
+    }
+    if (ekf && spec.aiding.barometer && spec.aiding.barometer->bias.sigma > 0.0) {
+      analysis.unrepresented.push_back("aiding.barometer.bias_gauss_markov_sigma_m");
+    }
+    // The EKF's analysis uses its propagation interval and discretisation, so that it predicts
+    // that filter; the free INS's uses covariance_step_samples with Van Loan's exact transition.
+    analysis.epochs = FilterCovarianceAnalysis(
+        spec.simulation.motion, spec.simulation.rate_hz, truth.ekf_noise, truth.ekf_P0,
+        ekf ? &spec.aiding : nullptr, truth.zupt_epochs, epoch_samples, analysis.step_samples,
+        ekf ? InsGnssFilterOptions().discretization : Discretization::kVanLoan);
+    output.covariance = std::move(analysis);
+  }
   data.timings.samples_processed = monitor.samples_done();
   data.timings.wall_s = Seconds(start);
-  return MonteCarloStatistics(std::move(data));
+  output.statistics = MonteCarloStatistics(std::move(data));
+  return output;
+}
+
+bool ReplayMonteCarloRun(const MonteCarloSpec& spec_in, uint32_t run, bool navigate,
+                         const std::function<void(const MonteCarloRunLayout&)>& on_start,
+                         const std::function<void(const MonteCarloRunStep&)>& on_step,
+                         const std::atomic<bool>* cancel) {
+  MonteCarloSpec spec = spec_in;
+  spec.first_run = run;
+  spec.run_count = 1;
+  ValidateSpec(spec);
+  if (spec.sensor) ValidateImuErrorModel(*spec.sensor, "sensor");
+  if (navigate && spec.filter != NavigationFilterKind::kNone) {
+    throw SpecError("navigation.filter", FilterName(spec.filter),
+                    "NONE to replay the run's navigation (the replay reproduces the free-inertial "
+                    "mechanization; the IMU data and truth are available with any filter)");
+  }
+  const SharedTruth s = BuildSharedTruth(spec, /*keep_imu=*/false);
+  const bool seed000 = spec.simulation.mechanization == MechanizationKind::kSeed000;
+  const bool gyrocompass = UseGyrocompass(spec, s);
+  const bool truth_height =
+      !seed000 && spec.simulation.ned.vertical == VerticalChannel::kTruthHeight;
+
+  MonteCarloRunLayout layout;
+  layout.env = &s.env;
+  layout.rate_hz = s.rate_hz;
+  layout.dt_s = s.dt_s;
+  layout.num_steps = s.n;
+  layout.navigation_start_step = s.start_step;
+  for (const Report& r : s.reports) {
+    if (r.epoch >= 0) ++layout.num_epochs;
+    if (r.checkpoint >= 0) ++layout.num_checkpoints;
+  }
+  if (on_start) on_start(layout);
+
+  // Two simulators of the run, as RunSimulation: increments (what mechanization A and
+  // RunMonteCarlo's kNed runs use) and point samples (mechanization B).
+  std::optional<ImuErrorSimulator> increment_errors, sample_errors;
+  if (spec.sensor) {
+    increment_errors.emplace(*spec.sensor, spec.seed, run, s.rate_hz);
+    sample_errors.emplace(*spec.sensor, spec.seed, run, s.rate_hz);
+  }
+  TrajectoryGenerator generator(spec.simulation.motion, spec.simulation.rate_hz);
+  const NavState truth0 = generator.initial_state();
+  ImuIncrement measured_increment;  // zero at k = 0
+  ImuSample measured_sample = generator.initial_sample();
+  if (sample_errors) sample_errors->Apply(generator.initial_sample(), &measured_sample);
+
+  std::optional<NedMechanization> ned;
+  std::optional<Seed000Mechanization> mech;
+  Eigen::Vector3d sum_dtheta = Eigen::Vector3d::Zero(), sum_dv = Eigen::Vector3d::Zero();
+  NavState nav;
+  size_t next_report = 0;
+  auto emit = [&](int64_t k, const NavState& truth) {
+    MonteCarloRunStep step;
+    step.k = k;
+    step.truth = &truth;
+    step.measured_increment = &measured_increment;
+    step.measured_sample = &measured_sample;
+    if (navigate && k >= s.start_step) step.nav = &nav;
+    if (next_report < s.reports.size() && s.reports[next_report].k == k) {
+      step.epoch = s.reports[next_report].epoch;
+      step.checkpoint = s.reports[next_report].checkpoint;
+      step.report_t_s = static_cast<double>(k) * s.dt_s;
+      ++next_report;
+    }
+    on_step(step);
+  };
+
+  // k = 0: mechanization B takes its first sample; mechanization A starts here unless aligning.
+  if (navigate && seed000) {
+    mech.emplace(s.dt_s, spec.simulation.seed000);
+    mech->Update(measured_sample);
+    if (s.start_step == 0) nav = mech->ToNed(s.env, truth0);
+  } else if (navigate && s.start_step == 0) {
+    ned.emplace(s.env, NedStartState(s, spec, run, gyrocompass, sum_dtheta, sum_dv), s.dt_s,
+                spec.simulation.ned);
+    nav = ned->state();
+  }
+  emit(0, truth0);
+
+  TrajectorySample sample;
+  while (generator.Next(&sample)) {
+    const int64_t k = generator.step();
+    if (increment_errors) {
+      increment_errors->Apply(sample.increment, &measured_increment);
+      sample_errors->Apply(sample.sample, &measured_sample);
+    } else {
+      measured_increment = sample.increment;
+      measured_sample = sample.sample;
+    }
+    if (navigate && seed000) {
+      mech->Update(measured_sample);
+      if (k >= s.start_step) nav = mech->ToNed(s.env, truth0);
+    } else if (navigate && k <= s.start_step) {
+      // Alignment window (k = 1..s0), then the start state at s0 (RunNed).
+      sum_dtheta += measured_increment.delta_theta_ib_b;
+      sum_dv += measured_increment.delta_v_ib_b;
+      if (k == s.start_step) {
+        ned.emplace(s.env, NedStartState(s, spec, run, gyrocompass, sum_dtheta, sum_dv), s.dt_s,
+                    spec.simulation.ned);
+        nav = ned->state();
+      }
+    } else if (navigate) {
+      ned->Update(measured_increment);
+      if (truth_height) ned->SetVertical(sample.truth.llh.h_m, sample.truth.v_eb_n.z());
+      nav = ned->state();
+    }
+    emit(k, sample.truth);
+    if ((k & (kPollSamples - 1)) == 0 && cancel != nullptr &&
+        cancel->load(std::memory_order_relaxed)) {
+      return false;
+    }
+  }
+  return true;
 }
 
 }  // namespace driftlab

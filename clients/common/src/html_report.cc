@@ -5,13 +5,19 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <utility>
 
 #include "driftlab/jobspec/result_file.h"
+#include "svg_plot.h"
 
 namespace driftlab::jobspec {
 namespace {
+
+using svg::Chart;
+using svg::Figure;
+using svg::kStyle;
+using svg::Num;
+using svg::Range;
 
 // At most this many epochs are drawn per envelope (every k-th and the last; the statistics
 // tables use all), and this many runs in the scatter (the first by run index; the histograms use
@@ -25,6 +31,7 @@ constexpr const char* kRmsColor = "#cb181d";
 constexpr const char* kCep50Color = "#238b45";
 constexpr const char* kCep95Color = "#d94801";
 constexpr const char* kBarColor = "#6baed6";
+constexpr const char* kPredictedColor = "#252525";
 
 v1::ErrorComponent Component(int c) { return static_cast<v1::ErrorComponent>(c + 1); }
 
@@ -46,158 +53,51 @@ std::string ComponentLabel(int c) {
 
 bool IsDistance(int c) { return c + 1 >= v1::HORIZONTAL_POSITION_M; }
 
-std::string Num(double value) { return fmt::format("{:.4g}", value); }
-
-// Prints a coordinate in the SVG (0.01 px resolution).
-std::string Px(double value) { return fmt::format("{:.2f}", value); }
-
-// Heckbert's nice number: 1, 2, 5 or 10 times a power of ten near x (rounded or at least x).
-double NiceNumber(double x, bool round) {
-  const double exponent = std::floor(std::log10(x));
-  const double power = std::pow(10.0, exponent);
-  const double f = x / power;
-  double nice = 10;
-  if (round) {
-    nice = f < 1.5 ? 1 : f < 3 ? 2 : f < 7 ? 5 : 10;
-  } else {
-    nice = f <= 1 ? 1 : f <= 2 ? 2 : f <= 5 ? 5 : 10;
+// The result carries a linear covariance analysis with one predicted epoch per epoch.
+bool HasPrediction(const v1::JobResult& result) {
+  if (!result.has_covariance() || result.covariance().epochs_size() != result.epochs_size()) {
+    return false;
   }
-  return nice * power;
+  for (const v1::PredictedEpoch& e : result.covariance().epochs()) {
+    if (e.sigma_size() != kErrorComponentCount) return false;
+  }
+  return true;
 }
 
-// A data range [lo, hi] with some room; degenerate ranges widened.
-struct Range {
-  double lo = std::numeric_limits<double>::infinity();
-  double hi = -std::numeric_limits<double>::infinity();
-  void Add(double v) {
-    if (std::isfinite(v)) {
-      lo = std::min(lo, v);
-      hi = std::max(hi, v);
-    }
+// Average NEES of the filter per epoch against its chi-square 95 % bounds (epochs with runs).
+std::string NeesPlot(const v1::JobResult& result) {
+  const v1::FilterConsistency& fc = result.filter_consistency();
+  std::vector<std::pair<double, double>> nees, lower, upper;
+  Range x, y;
+  const int n = fc.epochs_size();
+  const int stride = (n + kMaxDrawnEpochs - 1) / kMaxDrawnEpochs;
+  for (int i = 0; i < n; ++i) {
+    const v1::NeesEpoch& e = fc.epochs(i);
+    if ((i % stride != 0 && i != n - 1) || e.runs() == 0) continue;
+    nees.emplace_back(e.t_s(), e.average_nees());
+    lower.emplace_back(e.t_s(), e.chi2_95_low());
+    upper.emplace_back(e.t_s(), e.chi2_95_high());
+    x.Add(e.t_s());
+    for (const double v : {e.average_nees(), e.chi2_95_low(), e.chi2_95_high()}) y.Add(v);
   }
-  bool Empty() const { return !(lo <= hi); }
-};
-
-// One chart: a plot area with nice-number axes, written as an inline <svg>.
-class Chart {
- public:
-  Chart(double width, double height, Range x, Range y, std::string x_label, std::string y_label)
-      : width_(width), height_(height) {
-    x_ticks_ = NiceTicks(x.lo, x.hi);
-    y_ticks_ = NiceTicks(y.lo, y.hi);
-    svg_ = fmt::format(
-        "<svg class=\"chart\" width=\"{0}\" height=\"{1}\" viewBox=\"0 0 {0} {1}\" "
-        "role=\"img\">\n",
-        width_, height_);
-    Axes(x_label, y_label);
-  }
-
-  double X(double x) const {
-    return kLeft + (x - x_ticks_.lo) / (x_ticks_.hi - x_ticks_.lo) * (width_ - kLeft - kRight);
-  }
-  double Y(double y) const {
-    return height_ - kBottom -
-           (y - y_ticks_.lo) / (y_ticks_.hi - y_ticks_.lo) * (height_ - kTop - kBottom);
-  }
-  double PixelsPerUnitX() const { return (width_ - kLeft - kRight) / (x_ticks_.hi - x_ticks_.lo); }
-
-  void Polyline(const std::vector<std::pair<double, double>>& points, const char* color,
-                const char* extra = "") {
-    svg_ += "<polyline fill=\"none\" stroke-width=\"1.5\" stroke=\"";
-    svg_ += color;
-    svg_ += "\" ";
-    svg_ += extra;
-    svg_ += " points=\"";
-    for (const auto& [x, y] : points) svg_ += Px(X(x)) + "," + Px(Y(y)) + " ";
-    svg_ += "\"/>\n";
-  }
-
-  // A closed band between `upper` and `lower` (same x values).
-  void Band(const std::vector<std::pair<double, double>>& upper,
-            const std::vector<std::pair<double, double>>& lower, const char* color) {
-    svg_ +=
-        fmt::format("<polygon fill=\"{}\" fill-opacity=\"0.6\" stroke=\"none\" points=\"", color);
-    for (const auto& [x, y] : upper) svg_ += Px(X(x)) + "," + Px(Y(y)) + " ";
-    for (auto it = lower.rbegin(); it != lower.rend(); ++it) {
-      svg_ += Px(X(it->first)) + "," + Px(Y(it->second)) + " ";
-    }
-    svg_ += "\"/>\n";
-  }
-
-  void Dot(double x, double y) {
-    svg_ += fmt::format("<circle cx=\"{}\" cy=\"{}\" r=\"1.8\"/>", Px(X(x)), Px(Y(y)));
-  }
-
-  // Circle of radius r (x units) about (x, y); the chart must have equal scales.
-  void Circle(double x, double y, double r, const char* color) {
-    svg_ += fmt::format(
-        "<circle cx=\"{}\" cy=\"{}\" r=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"2\"/>\n",
-        Px(X(x)), Px(Y(y)), Px(r * PixelsPerUnitX()), color);
-  }
-
-  void Bar(double x0, double x1, double count) {
-    svg_ += fmt::format(
-        "<rect x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" fill=\"{}\" stroke=\"white\" "
-        "stroke-width=\"0.5\"/>",
-        Px(X(x0)), Px(Y(count)), Px(std::max(0.0, X(x1) - X(x0))), Px(Y(0) - Y(count)), kBarColor);
-  }
-
-  void VerticalLine(double x, const char* color) {
-    svg_ += fmt::format(
-        "<line x1=\"{0}\" x2=\"{0}\" y1=\"{1}\" y2=\"{2}\" stroke=\"{3}\" stroke-width=\"2\"/>\n",
-        Px(X(x)), Px(kTop), Px(height_ - kBottom), color);
-  }
-
-  void Raw(const std::string& text) { svg_ += text; }
-
-  std::string Finish() { return svg_ + "</svg>\n"; }
-
- private:
-  static constexpr double kLeft = 64, kRight = 14, kTop = 10, kBottom = 42;
-
-  std::string TickText(const AxisTicks& ticks, double value) const {
-    return fmt::format("{:.{}f}", value + 0.0, ticks.decimals);  // + 0.0: no "-0"
-  }
-
-  void Axes(const std::string& x_label, const std::string& y_label) {
-    const double x0 = kLeft, x1 = width_ - kRight, y0 = height_ - kBottom, y1 = kTop;
-    svg_ += "<g class=\"axes\">\n";
-    for (const double v : x_ticks_.values) {
-      const double x = X(v);
-      svg_ += fmt::format(
-          "<line class=\"grid\" x1=\"{0}\" x2=\"{0}\" y1=\"{1}\" y2=\"{2}\"/>"
-          "<text x=\"{0}\" y=\"{3}\" text-anchor=\"middle\">{4}</text>\n",
-          Px(x), Px(y0), Px(y1), Px(y0 + 14), TickText(x_ticks_, v));
-    }
-    for (const double v : y_ticks_.values) {
-      const double y = Y(v);
-      svg_ += fmt::format(
-          "<line class=\"grid\" x1=\"{0}\" x2=\"{1}\" y1=\"{2}\" y2=\"{2}\"/>"
-          "<text x=\"{3}\" y=\"{4}\" text-anchor=\"end\">{5}</text>\n",
-          Px(x0), Px(x1), Px(y), Px(x0 - 4), Px(y + 4), TickText(y_ticks_, v));
-    }
-    svg_ += fmt::format(
-        "<rect class=\"frame\" x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\"/>\n"
-        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{}</text>\n"
-        "<text transform=\"translate({},{}) rotate(-90)\" text-anchor=\"middle\">{}</text>\n",
-        Px(x0), Px(y1), Px(x1 - x0), Px(y0 - y1), Px((x0 + x1) / 2), Px(height_ - 8),
-        EscapeHtml(x_label), 14, Px((y0 + y1) / 2), EscapeHtml(y_label));
-    svg_ += "</g>\n";
-  }
-
-  double width_, height_;
-  AxisTicks x_ticks_, y_ticks_;
-  std::string svg_;
-};
-
-std::string Figure(const std::string& svg, const std::string& caption) {
-  return "<figure>" + svg + "<figcaption>" + EscapeHtml(caption) + "</figcaption></figure>\n";
+  if (nees.empty()) return "";
+  y.Add(0);
+  Chart chart(520, 230, x, y, "t [s]", "average NEES");
+  chart.Band(upper, lower, kBandColor);
+  chart.Polyline(nees, kMeanColor);
+  return Figure(
+      chart.Finish(),
+      fmt::format("average NEES of the {} navigation error states over the runs, with its "
+                  "chi-square 95 % band (mean over epochs {})",
+                  fc.state_dimension(), Num(fc.mean_average_nees())));
 }
 
 std::string EnvelopePlot(const v1::JobResult& result, int c) {
   const int n = result.epochs_size();
   const int stride = (n + kMaxDrawnEpochs - 1) / kMaxDrawnEpochs;
   std::vector<std::pair<double, double>> mean, upper, lower, rms, minus_rms;
+  std::vector<std::pair<double, double>> predicted_upper, predicted_lower;
+  const bool predicted = HasPrediction(result);
   Range x, y;
   y.Add(0);
   for (int i = 0; i < n; ++i) {
@@ -213,12 +113,30 @@ std::string EnvelopePlot(const v1::JobResult& result, int c) {
     x.Add(t);
     for (const double v : {s.mean() + std, s.mean() - std, s.rms()}) y.Add(v);
     if (!IsDistance(c)) y.Add(-s.rms());
+    if (predicted) {
+      // Linear covariance analysis: sigma about the Monte-Carlo mean for components 1-9 (to
+      // compare with the band), the predicted RMS for the distances (to compare with +RMS).
+      const double sigma = result.covariance().epochs(i).sigma(c);
+      if (IsDistance(c)) {
+        predicted_upper.emplace_back(t, sigma);
+      } else {
+        predicted_upper.emplace_back(t, s.mean() + sigma);
+        predicted_lower.emplace_back(t, s.mean() - sigma);
+      }
+      for (const auto& p : {predicted_upper.back()}) y.Add(p.second);
+      if (!predicted_lower.empty()) y.Add(predicted_lower.back().second);
+    }
   }
   Chart chart(330, 230, x, y, "t [s]", ComponentLabel(c));
   chart.Band(upper, lower, kBandColor);
   chart.Polyline(mean, kMeanColor);
   chart.Polyline(rms, kRmsColor, "stroke-dasharray=\"5,3\"");
   if (!IsDistance(c)) chart.Polyline(minus_rms, kRmsColor, "stroke-dasharray=\"5,3\"");
+  if (predicted) {
+    chart.Polyline(predicted_upper, kPredictedColor, "stroke-dasharray=\"1,2\"");
+    if (!IsDistance(c))
+      chart.Polyline(predicted_lower, kPredictedColor, "stroke-dasharray=\"1,2\"");
+  }
   std::string caption = ComponentKey(Component(c));
   if (stride > 1) caption += fmt::format(" (every {}th epoch drawn)", stride);
   return Figure(chart.Finish(), caption);
@@ -252,7 +170,7 @@ std::string Histogram(const std::vector<double>& values, const std::string& x_la
   Chart chart(width, height, range, y, x_label, "runs");
   for (int k = 0; k < bins; ++k) {
     if (counts[k] > 0) {
-      chart.Bar(range.lo + k * bin_width, range.lo + (k + 1) * bin_width, counts[k]);
+      chart.Bar(range.lo + k * bin_width, range.lo + (k + 1) * bin_width, counts[k], kBarColor);
     }
   }
   for (const auto& [x, color] : marks) chart.VerticalLine(x, color);
@@ -369,24 +287,6 @@ std::string JobJson(const v1::JobResult& result) {
   return json;
 }
 
-constexpr const char* kStyle = R"(<style>
-body { font-family: sans-serif; margin: 1.5em; color: #222; }
-h1 { font-size: 1.5em; } h2 { font-size: 1.2em; margin-top: 1.6em; }
-.grid { display: flex; flex-wrap: wrap; gap: 0.5em; }
-figure { margin: 0.3em; } figcaption { font-size: 0.85em; max-width: 520px; }
-svg.chart { font-size: 11px; }
-svg.chart text { fill: #222; }
-svg.chart line.grid { stroke: #ddd; stroke-width: 1; }
-svg.chart rect.frame { fill: none; stroke: #555; stroke-width: 1; }
-table { border-collapse: collapse; margin: 0.8em 0; font-size: 0.9em; }
-th, td { border: 1px solid #bbb; padding: 0.2em 0.5em; text-align: right; }
-th:first-child, td:first-child { text-align: left; }
-caption { text-align: left; font-weight: bold; padding: 0.3em 0; }
-pre { background: #f4f4f4; padding: 0.8em; overflow-x: auto; font-size: 0.85em; }
-.key { display: inline-block; width: 2em; height: 0.6em; margin: 0 0.3em 0 1em; }
-</style>
-)";
-
 }  // namespace
 
 std::string EscapeHtml(std::string_view text) {
@@ -416,27 +316,6 @@ std::string EscapeHtml(std::string_view text) {
   return out;
 }
 
-AxisTicks NiceTicks(double lo, double hi, int target) {
-  if (!std::isfinite(lo) || !std::isfinite(hi)) lo = hi = 0;
-  if (lo > hi) std::swap(lo, hi);
-  if (hi - lo <= std::abs(hi) * 1e-12) {  // one value: give it a range around itself
-    const double pad = hi != 0 ? std::abs(hi) * 0.1 : 1.0;
-    lo -= pad;
-    hi += pad;
-  }
-  target = std::max(target, 2);
-  AxisTicks ticks;
-  const double range = NiceNumber(hi - lo, false);
-  ticks.step = NiceNumber(range / (target - 1), true);
-  const double first = std::floor(lo / ticks.step);
-  const double last = std::ceil(hi / ticks.step);
-  ticks.lo = first * ticks.step;
-  ticks.hi = last * ticks.step;
-  ticks.decimals = std::max(0, -static_cast<int>(std::floor(std::log10(ticks.step))));
-  for (double k = first; k <= last; k += 1) ticks.values.push_back(k * ticks.step);
-  return ticks;
-}
-
 std::string RenderHtmlReport(const v1::JobResult& result) {
   const v1::Job& job = result.job();
   const std::string name = job.name().empty() ? "(unnamed job)" : job.name();
@@ -458,8 +337,23 @@ std::string RenderHtmlReport(const v1::JobResult& result) {
       "style=\"background:{}\"></span>mean <span class=\"key\" style=\"background:{}\"></span>"
       "&plusmn;RMS (dashed; +RMS only for distances)</p>\n<div class=\"grid\">\n",
       kBandColor, kMeanColor, kRmsColor);
+  if (HasPrediction(result)) {
+    html += fmt::format(
+        "<p>Dotted: the linear covariance analysis ({} filter, every {} IMU samples): mean "
+        "&plusmn; predicted &sigma;, predicted RMS for the distances.{}</p>\n",
+        EscapeHtml(result.covariance().filter()), result.covariance().step_samples(),
+        result.covariance().unrepresented().empty()
+            ? std::string()
+            : " Terms of the model the prediction leaves out: " +
+                  EscapeHtml(
+                      fmt::format("{}", fmt::join(result.covariance().unrepresented(), ", "))) +
+                  ".");
+  }
   for (int c = 0; c < kErrorComponentCount; ++c) html += EnvelopePlot(result, c);
   html += "</div>\n";
+  if (result.has_filter_consistency()) {
+    html += "<h2>Filter consistency</h2>\n<div class=\"grid\">\n" + NeesPlot(result) + "</div>\n";
+  }
 
   const v1::Checkpoint& final_checkpoint = *result.checkpoints().rbegin();
   html += "<h2>Final errors per run</h2>\n";

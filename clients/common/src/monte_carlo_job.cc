@@ -4,14 +4,18 @@
 #include <google/protobuf/util/message_differencer.h>
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <string>
 #include <vector>
 
+#include "driftlab/aiding.h"
+#include "driftlab/ins_gnss_filter.h"
 #include "driftlab/jobspec/sensor_model.h"
 #include "driftlab/jobspec/translate.h"
 #include "driftlab/spec_error.h"
+#include "driftlab/trajectory.h"
 #include "field_checks.h"
 
 namespace driftlab::jobspec {
@@ -37,9 +41,7 @@ bool IsAngle(int c) {
 // Engine unit -> result unit (radians -> degrees for the angles). Adding +0.0 turns -0 into +0:
 // protobuf's JSON parser reads "-0" as 0, so without it a shard written to a file and read back
 // would not reproduce the single-process bits.
-double ToResultUnit(int c, double value) {
-  return (IsAngle(c) ? value * kRadToDeg : value) + 0.0;
-}
+double ToResultUnit(int c, double value) { return (IsAngle(c) ? value * kRadToDeg : value) + 0.0; }
 
 Eigen::Vector3d Sigmas(const google::protobuf::RepeatedField<double>& values,
                        const std::string& path, double max, std::string_view unit, double scale) {
@@ -52,6 +54,231 @@ Eigen::Vector3d Sigmas(const google::protobuf::RepeatedField<double>& values,
     out[i] = Check(fmt::format("{}[{}]", path, i), values[i], Closed(0.0, max, unit)) * scale;
   }
   return out;
+}
+
+// A 3-vector field: empty = the default, else exactly 3 values each in `range`.
+Eigen::Vector3d Vector3Or(const google::protobuf::RepeatedField<double>& values,
+                          const std::string& path, const Range& range,
+                          const Eigen::Vector3d& default_value) {
+  if (values.empty()) return default_value;
+  if (values.size() != 3) {
+    throw SpecError(path, fmt::format("{} values", values.size()), "exactly 3 values");
+  }
+  Eigen::Vector3d out;
+  for (int i = 0; i < 3; ++i) out[i] = Check(fmt::format("{}[{}]", path, i), values[i], range);
+  return out;
+}
+
+// An aiding rate: absent = the IMU rate divided by the smallest integer that brings it to
+// default_hz or below; else 0 < rate <= rate_hz with rate_hz / rate an integer.
+double AidingRate(const std::string& path, bool has, double value, double default_hz,
+                  double rate_hz) {
+  if (!has) return rate_hz / std::ceil(rate_hz / default_hz - 1e-9);
+  Range range = Positive(rate_hz, "Hz");
+  range.note = "(at most the IMU rate rate_hz, which it must divide by an integer)";
+  Check(path, value, range);
+  AidingDecimation(value, rate_hz, path);
+  return value;
+}
+
+constexpr double kMaxAidingSigma_m = 1000.0;
+constexpr double kMaxAidingSigma_m_per_s = 100.0;
+constexpr double kMaxCorrelationTime_s = 1.0e6;
+
+GnssConfig ToGnssConfig(const v1::GnssAiding& in, double rate_hz, double duration_s) {
+  const std::string p = "aiding.gnss";
+  GnssConfig g;
+  g.rate_hz = AidingRate(p + ".rate_hz", in.has_rate_hz(), in.rate_hz(), 1.0, rate_hz);
+  g.position_sigma_ned_m = Vector3Or(in.position_sigma_ned_m(), p + ".position_sigma_ned_m",
+                                     Closed(0.0, kMaxAidingSigma_m, "m"), g.position_sigma_ned_m);
+  g.velocity_sigma_ned_m_per_s =
+      Vector3Or(in.velocity_sigma_ned_m_per_s(), p + ".velocity_sigma_ned_m_per_s",
+                Closed(0.0, kMaxAidingSigma_m_per_s, "m/s"), g.velocity_sigma_ned_m_per_s);
+  g.position_gauss_markov_sigma_ned_m =
+      Vector3Or(in.position_gauss_markov_sigma_ned_m(), p + ".position_gauss_markov_sigma_ned_m",
+                Closed(0.0, kMaxAidingSigma_m, "m"), g.position_gauss_markov_sigma_ned_m);
+  g.position_gauss_markov_tau_s =
+      OptionalOr(p + ".position_gauss_markov_tau_s", in.has_position_gauss_markov_tau_s(),
+                 in.position_gauss_markov_tau_s(), g.position_gauss_markov_tau_s,
+                 Positive(kMaxCorrelationTime_s, "s"));
+  g.lever_arm_b_m = Vector3Or(in.lever_arm_b_m(), p + ".lever_arm_b_m", Closed(-100.0, 100.0, "m"),
+                              Eigen::Vector3d::Zero());
+  g.use_velocity = in.has_use_velocity() ? in.use_velocity() : true;
+  double previous_end_s = 0.0;
+  for (int i = 0; i < in.outages_size(); ++i) {
+    const v1::GnssOutage& o = in.outages(i);
+    const std::string f = fmt::format("{}.outages[{}]", p, i);
+    Range start_range = Closed(0.0, duration_s, "s");
+    start_range.hi_open = true;
+    start_range.note = "(inside the trajectory)";
+    const double start_s = Required(f + ".start_s", o.has_start_s(), o.start_s(), start_range);
+    if (i > 0 && start_s < previous_end_s) {
+      throw SpecError(f + ".start_s", fmt::format("{}", start_s),
+                      fmt::format(">= {} s, the end of outages[{}] (outages ascending and not "
+                                  "overlapping)",
+                                  previous_end_s, i - 1));
+    }
+    Range end_range = Closed(start_s, duration_s, "s");
+    end_range.lo_open = true;
+    end_range.note = "(after start_s, inside the trajectory)";
+    const double end_s = Required(f + ".end_s", o.has_end_s(), o.end_s(), end_range);
+    g.outages.push_back(GnssOutage{start_s, end_s - start_s});
+    previous_end_s = end_s;
+  }
+  // Zero sigmas, lever arm length and the rest, with the engine's own messages.
+  ValidateGnssConfig(g, rate_hz, p);
+  return g;
+}
+
+BarometerConfig ToBarometerConfig(const v1::BarometerAiding& in, double rate_hz) {
+  const std::string p = "aiding.barometer";
+  BarometerConfig b;
+  b.rate_hz = AidingRate(p + ".rate_hz", in.has_rate_hz(), in.rate_hz(), 10.0, rate_hz);
+  b.noise_sigma_m = OptionalOr(p + ".noise_sigma_m", in.has_noise_sigma_m(), in.noise_sigma_m(),
+                               b.noise_sigma_m, Positive(kMaxAidingSigma_m, "m"));
+  b.bias.sigma =
+      OptionalOr(p + ".bias_gauss_markov_sigma_m", in.has_bias_gauss_markov_sigma_m(),
+                 in.bias_gauss_markov_sigma_m(), 0.0, Closed(0.0, kMaxAidingSigma_m, "m"));
+  if (b.bias.sigma > 0.0) {
+    b.bias.tau_s = Required(p + ".bias_gauss_markov_tau_s", in.has_bias_gauss_markov_tau_s(),
+                            in.bias_gauss_markov_tau_s(), Positive(kMaxCorrelationTime_s, "s"));
+  } else if (in.has_bias_gauss_markov_tau_s()) {
+    b.bias.tau_s = Check(p + ".bias_gauss_markov_tau_s", in.bias_gauss_markov_tau_s(),
+                         Positive(kMaxCorrelationTime_s, "s"));
+  }
+  ValidateBarometerConfig(b, rate_hz, p);
+  return b;
+}
+
+MagnetometerConfig ToMagnetometerConfig(const v1::MagnetometerAiding& in, double rate_hz) {
+  const std::string p = "aiding.magnetometer";
+  MagnetometerConfig m;
+  m.rate_hz = AidingRate(p + ".rate_hz", in.has_rate_hz(), in.rate_hz(), rate_hz, rate_hz);
+  m.earth_field_n = Vector3Or(in.earth_field_ned_ut(), p + ".earth_field_ned_ut",
+                              Closed(-1000.0, 1000.0, "uT"), m.earth_field_n);
+  m.hard_iron_b = Vector3Or(in.hard_iron_ut(), p + ".hard_iron_ut", Closed(-1000.0, 1000.0, "uT"),
+                            Eigen::Vector3d::Zero());
+  const auto& soft = in.soft_iron();
+  if (!soft.empty() && soft.size() != 3 && soft.size() != 9) {
+    throw SpecError(p + ".soft_iron", fmt::format("{} values", soft.size()),
+                    "3 values (diagonal) or 9 (row order)");
+  }
+  for (int i = 0; i < soft.size(); ++i) {
+    Check(fmt::format("{}.soft_iron[{}]", p, i), soft[i], Closed(-10.0, 10.0, ""));
+  }
+  if (soft.size() == 3) {
+    m.soft_iron = Eigen::Vector3d(soft[0], soft[1], soft[2]).asDiagonal();
+  } else if (soft.size() == 9) {
+    for (int i = 0; i < 9; ++i) m.soft_iron(i / 3, i % 3) = soft[i];
+  }
+  m.noise_sigma = OptionalOr(p + ".noise_sigma_ut", in.has_noise_sigma_ut(), in.noise_sigma_ut(),
+                             m.noise_sigma, Closed(0.0, 1000.0, "uT"));
+  ValidateMagnetometerConfig(m, rate_hz, p);
+  return m;
+}
+
+ZuptConfig ToZuptConfig(const v1::ZuptAiding& in, double rate_hz) {
+  const std::string p = "aiding.zupt";
+  ZuptConfig z;
+  z.rate_hz = AidingRate(p + ".rate_hz", in.has_rate_hz(), in.rate_hz(), 1.0, rate_hz);
+  z.velocity_sigma_m_per_s =
+      OptionalOr(p + ".velocity_sigma_m_per_s", in.has_velocity_sigma_m_per_s(),
+                 in.velocity_sigma_m_per_s(), z.velocity_sigma_m_per_s, Positive(10.0, "m/s"));
+  return z;
+}
+
+// navigation.filter / ekf / complementary, aiding and the covariance switch.
+void TranslateFilterAndAiding(const v1::Job& job, const MonteCarloOverrides& overrides,
+                              MonteCarloSpec* spec) {
+  const v1::Navigation& nav = job.navigation();
+  const double rate_hz = spec->simulation.rate_hz;
+  switch (nav.filter()) {
+    case v1::Navigation::FILTER_UNSPECIFIED:
+    case v1::Navigation::NONE:
+      spec->filter = NavigationFilterKind::kNone;
+      break;
+    case v1::Navigation::INS_GNSS_EKF:
+      spec->filter = NavigationFilterKind::kInsGnssEkf;
+      break;
+    case v1::Navigation::COMPLEMENTARY:
+      spec->filter = NavigationFilterKind::kComplementary;
+      break;
+    default:
+      throw SpecError("navigation.filter", fmt::format("{}", static_cast<int>(nav.filter())),
+                      "one of NONE, INS_GNSS_EKF, COMPLEMENTARY");
+  }
+  if (nav.has_ekf() && spec->filter != NavigationFilterKind::kInsGnssEkf) {
+    throw SpecError("navigation.ekf", "set", "only with navigation.filter INS_GNSS_EKF");
+  }
+  if (nav.has_complementary() && spec->filter != NavigationFilterKind::kComplementary) {
+    throw SpecError("navigation.complementary", "set", "only with navigation.filter COMPLEMENTARY");
+  }
+  spec->ekf_propagation_step_samples = static_cast<int64_t>(OptionalOr(
+      "navigation.ekf.propagation_step_samples", nav.ekf().has_propagation_step_samples(),
+      nav.ekf().propagation_step_samples(), 10.0, Closed(1.0, 10000.0, "samples")));
+  const v1::ComplementaryOptions& c = nav.complementary();
+  switch (c.pair()) {
+    case v1::ComplementaryOptions::PAIR_UNSPECIFIED:
+    case v1::ComplementaryOptions::FIRST_ORDER:
+      spec->complementary.kind = ComplementaryPairKind::kFirstOrder;
+      break;
+    case v1::ComplementaryOptions::BUTTERWORTH4:
+      spec->complementary.kind = ComplementaryPairKind::kButterworth4;
+      break;
+    case v1::ComplementaryOptions::BUTTERWORTH4_SEED:
+      spec->complementary.kind = ComplementaryPairKind::kButterworth4Seed;
+      break;
+    default:
+      throw SpecError("navigation.complementary.pair",
+                      fmt::format("{}", static_cast<int>(c.pair())),
+                      "one of FIRST_ORDER, BUTTERWORTH4, BUTTERWORTH4_SEED");
+  }
+  Range crossover = Positive(rate_hz / 2.0, "Hz");
+  crossover.hi_open = true;
+  crossover.note = "(below half the IMU rate)";
+  spec->complementary.crossover_hz =
+      OptionalOr("navigation.complementary.crossover_hz", c.has_crossover_hz(), c.crossover_hz(),
+                 0.1, crossover);
+  spec->complementary.heading_crossover_hz =
+      OptionalOr("navigation.complementary.heading_crossover_hz", c.has_heading_crossover_hz(),
+                 c.heading_crossover_hz(), 0.01, crossover);
+
+  const v1::Aiding& aiding = job.aiding();
+  if (aiding.has_gnss()) {
+    double duration_s = 0.0;
+    if (aiding.gnss().outages_size() > 0) {
+      // Outages must lie inside the trajectory: its duration from the motion plan.
+      duration_s = TrajectoryGenerator(spec->simulation.motion, rate_hz).duration_s();
+    }
+    spec->aiding.gnss = ToGnssConfig(aiding.gnss(), rate_hz, duration_s);
+  }
+  if (aiding.has_barometer()) {
+    spec->aiding.barometer = ToBarometerConfig(aiding.barometer(), rate_hz);
+  }
+  if (aiding.has_magnetometer()) {
+    spec->aiding.magnetometer = ToMagnetometerConfig(aiding.magnetometer(), rate_hz);
+  }
+  if (aiding.has_zupt() && aiding.zupt().enabled()) {
+    spec->aiding.zupt = ToZuptConfig(aiding.zupt(), rate_hz);
+  }
+
+  const v1::MonteCarlo& mc = job.monte_carlo();
+  spec->covariance = overrides.covariance || (mc.has_covariance() && mc.covariance());
+  spec->covariance_step_samples = static_cast<int64_t>(
+      OptionalOr("monte_carlo.covariance_step_samples", mc.has_covariance_step_samples(),
+                 mc.covariance_step_samples(), 10.0, Closed(1.0, 10000.0, "samples")));
+  if (overrides.covariance && !mc.has_covariance()) {
+    // Name the flag, not the field, when the combination does not fit.
+    try {
+      ValidateFilterAndAiding(*spec);
+    } catch (const SpecError& e) {
+      if (e.field() != "monte_carlo.covariance") throw;
+      throw SpecError("--covariance", "given",
+                      "only with mechanization NED, vertical channel FREE, initialization "
+                      "TRUTH_PLUS_ERRORS and navigation.filter NONE or INS_GNSS_EKF");
+    }
+  }
+  ValidateFilterAndAiding(*spec);
 }
 
 void SetStatistics(const ComponentEpochSummary& in, int c, v1::ComponentStatistics* out) {
@@ -72,6 +299,100 @@ void SetExactSum(const ExactSum& sum, v1::ExactSum* out) {
 ExactSum GetExactSum(const v1::ExactSum& in, const std::string& field) {
   const std::vector<int64_t> limbs(in.limbs().begin(), in.limbs().end());
   return ExactSum::Deserialize(limbs, field);
+}
+
+const char* FilterName(NavigationFilterKind filter) {
+  switch (filter) {
+    case NavigationFilterKind::kInsGnssEkf:
+      return "INS_GNSS_EKF";
+    case NavigationFilterKind::kComplementary:
+      return "COMPLEMENTARY";
+    case NavigationFilterKind::kNone:
+      break;
+  }
+  return "NONE";
+}
+
+// Predicted sigma of the 11 components (mc_statistics.h order) in the result's units: N, E, D
+// position and velocity sigma, roll/pitch/yaw sigma, then the RMS horizontal and 3-D position
+// errors sqrt(P_NN + P_EE) and sqrt(P_NN + P_EE + P_DD).
+void SetCovariance(const CovarianceAnalysisResult& analysis,
+                   const std::vector<double>& epoch_times_s, v1::JobResult* result) {
+  if (analysis.epochs.size() != epoch_times_s.size()) {
+    throw SpecError("result.covariance", fmt::format("{} epochs", analysis.epochs.size()),
+                    fmt::format("one per statistics epoch ({})", epoch_times_s.size()));
+  }
+  v1::CovarianceAnalysis* out = result->mutable_covariance();
+  out->set_filter(FilterName(analysis.filter));
+  out->set_step_samples(static_cast<uint32_t>(analysis.step_samples));
+  for (const std::string& term : analysis.unrepresented) out->add_unrepresented(term);
+  for (size_t e = 0; e < analysis.epochs.size(); ++e) {
+    const CovarianceEpoch& in = analysis.epochs[e];
+    v1::PredictedEpoch* epoch = out->add_epochs();
+    epoch->set_t_s(epoch_times_s[e]);
+    std::array<double, kNumErrorComponents> sigma{};
+    for (int c = 0; c < 6; ++c) sigma[c] = in.sigma[c];
+    for (int c = 0; c < 3; ++c) sigma[6 + c] = in.euler_sigma_rad[c];
+    sigma[static_cast<int>(ErrorComponent::kHorizontalPosition)] = in.horizontal_sigma_m;
+    sigma[static_cast<int>(ErrorComponent::kPosition3d)] =
+        std::sqrt(std::max(0.0, in.P(0, 0) + in.P(1, 1) + in.P(2, 2)));
+    for (int c = 0; c < kNumErrorComponents; ++c) epoch->add_sigma(ToResultUnit(c, sigma[c]));
+  }
+}
+
+// filter_consistency from the NEES sums, and the sums into the merge state.
+void SetConsistency(const FilterConsistencyData& data, const std::vector<double>& epoch_times_s,
+                    v1::JobResult* result) {
+  if (data.nees_sum.size() != epoch_times_s.size() ||
+      data.nees_count.size() != epoch_times_s.size()) {
+    throw SpecError("result.filter_consistency", fmt::format("{} epochs", data.nees_sum.size()),
+                    fmt::format("one per statistics epoch ({})", epoch_times_s.size()));
+  }
+  v1::FilterConsistency* out = result->mutable_filter_consistency();
+  out->set_state_dimension(FilterConsistencyData::kStateDimension);
+  v1::MergeState* merge = result->mutable_merge_state();
+  merge->clear_nees_sums();
+  merge->clear_nees_counts();
+  double sum_of_averages = 0.0;
+  int averaged_epochs = 0;
+  for (size_t e = 0; e < epoch_times_s.size(); ++e) {
+    SetExactSum(data.nees_sum[e], merge->add_nees_sums());
+    merge->add_nees_counts(data.nees_count[e]);
+    v1::NeesEpoch* epoch = out->add_epochs();
+    epoch->set_t_s(epoch_times_s[e]);
+    const uint64_t n = data.nees_count[e];
+    epoch->set_runs(n);
+    if (n == 0) continue;
+    const double average =
+        static_cast<double>(data.nees_sum[e].Value() / static_cast<long double>(n));
+    epoch->set_average_nees(average);
+    double low = 0.0, high = 0.0;
+    Chi2MeanBounds95(FilterConsistencyData::kStateDimension, static_cast<int>(n), &low, &high);
+    epoch->set_chi2_95_low(low);  // chi2_0.025(9 n) / n
+    epoch->set_chi2_95_high(high);
+    sum_of_averages += average;
+    ++averaged_epochs;
+  }
+  if (averaged_epochs > 0) out->set_mean_average_nees(sum_of_averages / averaged_epochs);
+}
+
+FilterConsistencyData ConsistencyFromJobResult(const v1::JobResult& result,
+                                               const std::string& source) {
+  const v1::MergeState& merge = result.merge_state();
+  if (merge.nees_sums_size() != result.epochs_size() ||
+      merge.nees_counts_size() != result.epochs_size()) {
+    throw SpecError(
+        source + ": merge_state.nees_sums",
+        fmt::format("{} sums, {} counts", merge.nees_sums_size(), merge.nees_counts_size()),
+        fmt::format("one of each per epoch ({})", result.epochs_size()));
+  }
+  FilterConsistencyData data;
+  for (int e = 0; e < merge.nees_sums_size(); ++e) {
+    data.nees_sum.push_back(
+        GetExactSum(merge.nees_sums(e), fmt::format("{}: merge_state.nees_sums[{}]", source, e)));
+    data.nees_count.push_back(merge.nees_counts(e));
+  }
+  return data;
 }
 
 }  // namespace
@@ -205,6 +526,7 @@ MonteCarloSpec ToMonteCarloSpec(const JobFile& file, const MonteCarloOverrides& 
     Check(fmt::format("monte_carlo.checkpoint_times_s[{}]", i), spec.checkpoint_times_s[i],
           Closed(0.0, 1.0e7, "s"));
   }
+  TranslateFilterAndAiding(file.job, overrides, &spec);
   return spec;
 }
 
@@ -212,6 +534,7 @@ v1::Job JobAsRun(const v1::Job& job, const MonteCarloSpec& spec) {
   v1::Job out = job;
   out.mutable_monte_carlo()->set_runs(spec.runs);
   out.mutable_monte_carlo()->set_seed(spec.seed);
+  if (spec.covariance) out.mutable_monte_carlo()->set_covariance(true);  // `run --covariance`
   return out;
 }
 
@@ -302,6 +625,15 @@ v1::JobResult ToJobResult(const v1::Job& job_as_run, const MonteCarloStatistics&
   return result;
 }
 
+v1::JobResult ToJobResult(const v1::Job& job_as_run, const MonteCarloOutput& output,
+                          const std::string& engine_version, double cpu_s) {
+  v1::JobResult result = ToJobResult(job_as_run, output.statistics, engine_version, cpu_s);
+  const std::vector<double>& times = output.statistics.data().epoch_times_s;
+  if (output.covariance) SetCovariance(*output.covariance, times, &result);
+  if (output.consistency) SetConsistency(*output.consistency, times, &result);
+  return result;
+}
+
 MonteCarloStatistics StatisticsFromJobResult(const v1::JobResult& result,
                                              const std::string& source) {
   const v1::MergeState& merge = result.merge_state();
@@ -368,6 +700,15 @@ v1::JobResult MergeJobResults(const std::vector<v1::JobResult>& shards,
     merged.Merge(StatisticsFromJobResult(shards[i], sources[i]));
   }
   v1::JobResult result = ToJobResult(shards[0].job(), merged, engine_version);
+  // The covariance analysis depends on the job only: every shard holds the same.
+  if (shards[0].has_covariance()) *result.mutable_covariance() = shards[0].covariance();
+  if (shards[0].has_filter_consistency()) {
+    FilterConsistencyData nees = ConsistencyFromJobResult(shards[0], sources[0]);
+    for (size_t i = 1; i < shards.size(); ++i) {
+      nees.Merge(ConsistencyFromJobResult(shards[i], sources[i]));
+    }
+    SetConsistency(nees, merged.data().epoch_times_s, &result);
+  }
   // The per-run checkpoint values exactly as the shards hold them (the conversion to the engine
   // and back need not reproduce the bits of the angles), in run order.
   for (int k = 0; k < result.checkpoints_size(); ++k) {

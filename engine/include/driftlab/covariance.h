@@ -6,6 +6,7 @@
 // (covariance propagation); Groves 2nd ed. section 3.2.2 (system propagation), 14.2.
 #pragma once
 
+#include <Eigen/Cholesky>
 #include <cstdint>
 #include <vector>
 
@@ -61,6 +62,24 @@ std::vector<CovarianceEpoch> FreeInertialCovariance(const Trajectory& trajectory
                                                     const ErrorStateNoise& noise,
                                                     const ErrorStateMatrix& P0,
                                                     const CovarianceAnalysisOptions& options);
+
+// Kalman measurement update of the covariance in Joseph form (Bucy & Joseph 1968; Groves 2nd ed.
+// (3.58)): S = H P H^T + R, K = P H^T S^-1, P <- (I - K H) P (I - K H)^T + K R K^T, symmetrised.
+// Returns K; *S_llt (optional) receives the Cholesky factor of S (for the innovation's NIS).
+template <int M>
+Eigen::Matrix<double, kNumErrorStates, M> JosephUpdate(
+    const Eigen::Matrix<double, M, kNumErrorStates>& H, const Eigen::Matrix<double, M, M>& R,
+    ErrorStateMatrix* P, Eigen::LLT<Eigen::Matrix<double, M, M>>* S_llt = nullptr) {
+  const Eigen::Matrix<double, M, M> S = H * (*P) * H.transpose() + R;
+  const Eigen::LLT<Eigen::Matrix<double, M, M>> llt(S);
+  // K = P H^T S^-1 = (S^-1 H P)^T for symmetric P and S.
+  const Eigen::Matrix<double, kNumErrorStates, M> K = llt.solve(H * (*P)).transpose();
+  const ErrorStateMatrix IKH = ErrorStateMatrix::Identity() - K * H;
+  *P = (IKH * (*P) * IKH.transpose()).eval() + K * R * K.transpose();
+  *P = 0.5 * (*P + P->transpose()).eval();
+  if (S_llt != nullptr) *S_llt = llt;
+  return K;
+}
 
 // The epoch record of P at time t_s with the truth attitude `attitude` (for the Euler sigmas).
 CovarianceEpoch MakeCovarianceEpoch(double t_s, const ErrorStateMatrix& P,

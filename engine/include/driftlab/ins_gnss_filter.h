@@ -12,6 +12,11 @@
 //     (signs for x = estimate - truth), R = diag(white^2 + Gauss-Markov^2) (the correlated GNSS
 //     error is treated as white: it is not a state), K = P H^T (H P H^T + R)^-1,
 //     P <- (I - K H) P (I - K H)^T + K R K^T (Joseph form);
+//   * barometer (UpdateHeight): z = h_baro - h^ = dr_D + noise (x = estimate - truth, dr_D = -dh),
+//     H = [0 0 1 | 0 ...], R = noise^2 + bias^2 (the barometer's Gauss-Markov bias is treated as
+//     white, like the GNSS correlated error);
+//   * zero velocity (UpdateZeroVelocity, Groves section 15.3.1): z = v^_eb_n - v_measured (0 plus
+//     the residual motion), H = [0, I, 0, 0, 0], R = sigma^2 I;
 //   * closed loop: the estimated error x = K z is removed from the navigation state at once
 //     (position and velocity subtracted, attitude C_b_n <- exp(-[psi x]) C_b_n) and added to the
 //     bias estimates, then x = 0. The mechanization restarts from the corrected state, so its
@@ -22,7 +27,9 @@
 
 #include <cstdint>
 #include <optional>
+#include <vector>
 
+#include "driftlab/aiding.h"
 #include "driftlab/covariance.h"
 #include "driftlab/error_state.h"
 #include "driftlab/gnss.h"
@@ -48,6 +55,12 @@ class InsGnssFilter {
   // GNSS update with a fix taken at the current time; omega_ib_b is the measured body rate (for
   // the lever-arm velocity).
   void Update(const GnssMeasurement& fix, const Vector3d& omega_ib_b);
+  // Barometric height h_m [m] with its 1-sigma sigma_m (noise and bias together) at the current
+  // time.
+  void UpdateHeight(double h_m, double sigma_m);
+  // Zero-velocity measurement v_measured_n (0 plus the standing vehicle's residual motion) with
+  // 1-sigma sigma_m_per_s per axis at the current time.
+  void UpdateZeroVelocity(double sigma_m_per_s, const Vector3d& v_measured_n = Vector3d::Zero());
   // Propagates P over the samples since the last propagation (so that P is at state().t_s).
   void SyncCovariance();
 
@@ -55,11 +68,17 @@ class InsGnssFilter {
   const ErrorStateMatrix& P() const { return propagator_.P(); }
   const Vector3d& accel_bias() const { return accel_bias_; }  // b^_a [m/s^2]
   const Vector3d& gyro_bias() const { return gyro_bias_; }    // b^_g [rad/s]
+  const InsGnssFilterOptions& options() const { return options_; }
   // Normalised innovation squared z^T S^-1 z of the last update and its dimension (3 or 6).
   double last_nis() const { return last_nis_; }
   int last_measurement_dim() const { return last_dim_; }
 
  private:
+  // Kalman update with innovation z (estimate minus measurement), then the closed-loop correction.
+  template <int M>
+  void Correct(const Eigen::Matrix<double, M, kNumErrorStates>& H,
+               const Eigen::Matrix<double, M, M>& R, const Eigen::Matrix<double, M, 1>& z);
+
   NavEnvironment env_;
   double dt_s_;
   InsGnssFilterOptions options_;
@@ -72,6 +91,34 @@ class InsGnssFilter {
   double last_nis_ = 0.0;
   int last_dim_ = 0;
 };
+
+// The GNSS measurement model of the filter at state s with the (bias-corrected) body rate
+// omega_ib_b: H (rows 0-2 position, 3-5 velocity; the first `dim` rows used), R, and the lever
+// arm's position C_b_n l_b and velocity C_b_n (omega_ib_b x l_b) - omega_ie_n x C_b_n l_b in n.
+struct GnssUpdateModel {
+  Eigen::Matrix<double, 6, kNumErrorStates> H = Eigen::Matrix<double, 6, kNumErrorStates>::Zero();
+  Eigen::Matrix<double, 6, 6> R = Eigen::Matrix<double, 6, 6>::Zero();
+  Vector3d lever_n = Vector3d::Zero();
+  Vector3d lever_velocity_n = Vector3d::Zero();
+  int dim = 3;
+};
+GnssUpdateModel MakeGnssUpdateModel(const NavEnvironment& env, const GnssConfig& gnss,
+                                    const NavState& s, const Vector3d& omega_ib_b);
+
+// Linear covariance analysis of the filter (or of the free INS) along the truth trajectory of
+// `motion` at rate_hz, streamed (memory O(step_samples)): P0 at t = 0, propagated as the filter
+// does (every step_samples samples, and at every epoch and update sample; F at the truth state at
+// the end of the interval with its mean specific force), and at each sample after recording an
+// epoch, updated in Joseph form by the aids the filter uses, in the filter's order: GNSS (at its
+// epochs outside the outages, H with the truth attitude and the ideal body rate), barometer,
+// ZUPT (at zupt_epochs). aiding = nullptr: free inertial. epoch_samples ascending in [0, n].
+// The gain is the one a filter running on the truth would use; for a consistent filter the
+// predicted sigma is the Monte-Carlo spread (Maybeck vol. 1, section 6.8; Gelb, "Applied Optimal
+// Estimation", section 7.1, covariance analysis).
+std::vector<CovarianceEpoch> FilterCovarianceAnalysis(
+    const MotionSpec& motion, double rate_hz, const ErrorStateNoise& noise,
+    const ErrorStateMatrix& P0, const AidingSpec* aiding, const std::vector<int64_t>& zupt_epochs,
+    const std::vector<int64_t>& epoch_samples, int64_t step_samples, Discretization method);
 
 // The normalised estimation error squared e^T P^-1 e (NEES) of a 15-state error.
 double Nees(const ErrorStateVector& error, const ErrorStateMatrix& P);

@@ -20,6 +20,10 @@
 #include <optional>
 #include <vector>
 
+#include "driftlab/aiding.h"
+#include "driftlab/complementary_filter.h"
+#include "driftlab/covariance.h"
+#include "driftlab/exact_sum.h"
 #include "driftlab/mc_statistics.h"
 #include "driftlab/sensor_params.h"
 #include "driftlab/simulate.h"
@@ -69,6 +73,20 @@ struct AlignmentOptions {
   std::optional<double> heading_sigma_rad;  // 1-sigma of the external heading [rad], > 0
 };
 
+// The navigation filter of each run (mechanization A only).
+enum class NavigationFilterKind {
+  kNone,  // free inertial: the mechanization alone
+  // Loosely coupled 15-state EKF (ins_gnss_filter.h), closed loop, updated by the configured GNSS,
+  // barometer and ZUPT (in that order at a sample where several fall). Needs kTruthPlusErrors
+  // (P0 from initial_errors and the sensor's bias sigmas) and VerticalChannel::kFree.
+  kInsGnssEkf,
+  // Seed 003's complementary attitude filter (complementary_filter.h) on the measured point
+  // samples, heading from the magnetometer if configured. Errors: roll, pitch, yaw; the position
+  // and velocity errors are reported as 0 (the filter does not estimate them). The initial yaw is
+  // the truth's plus initial_errors.attitude_rad[2] (used when there is no magnetometer).
+  kComplementary,
+};
+
 struct MonteCarloSpec {
   SimulationSpec simulation;            // motion, IMU rate, mechanization A or B and its options
   std::optional<ImuErrorModel> sensor;  // absent = error-free IMU (only initial errors act)
@@ -94,6 +112,48 @@ struct MonteCarloSpec {
   // is always a checkpoint and is appended if not listed.
   std::vector<double> checkpoint_times_s;
   int threads = 0;  // worker threads; 0 = all hardware threads
+
+  // Navigation filter and aiding (issue 7). Random aiding errors come from RandomStream(seed, run,
+  // {SensorId::kGnss / kBarometer / kMagnetometer, ...}) (gnss.h, aiding.h), so results stay
+  // bit-identical for any thread count and shard split.
+  NavigationFilterKind filter = NavigationFilterKind::kNone;
+  AidingSpec aiding;
+  int64_t ekf_propagation_step_samples = 10;  // InsGnssFilterOptions::propagation_step_samples
+  // kComplementary: kind and crossover frequencies (magnetic_declination_rad and initial_yaw_rad
+  // are set per run from the magnetometer's field and the initial errors).
+  ComplementaryFilterOptions complementary;
+  // Linear covariance analysis (RunMonteCarloWithAnalysis): needs kNed, kTruthPlusErrors,
+  // VerticalChannel::kFree and filter kNone or kInsGnssEkf.
+  bool covariance = false;
+  int64_t covariance_step_samples = 10;  // propagation interval [IMU samples], 1 to 10000
+};
+
+// Filter consistency of a kInsGnssEkf job: per output epoch, the exact sum over runs of the NEES
+// of the 9 navigation error states (position, velocity, attitude psi_nb_n) against the filter's
+// own covariance, and the number of runs in it (a run whose 9 x 9 covariance block is not
+// positive definite at that epoch, as at a navigation start with zero initial sigmas, adds
+// nothing). Mergeable like the epoch sums.
+struct FilterConsistencyData {
+  static constexpr int kStateDimension = 9;
+  std::vector<ExactSum> nees_sum;    // per epoch
+  std::vector<uint64_t> nees_count;  // per epoch
+  // Adds `other` (a shard of the same job, same epochs); throws SpecError("statistics.nees", ...)
+  // for a different number of epochs.
+  void Merge(const FilterConsistencyData& other);
+};
+
+// Predicted sigmas of the job's error model at the output epochs (FilterCovarianceAnalysis).
+struct CovarianceAnalysisResult {
+  NavigationFilterKind filter = NavigationFilterKind::kNone;
+  int64_t step_samples = 0;
+  std::vector<CovarianceEpoch> epochs;     // at the statistics' epoch times
+  std::vector<std::string> unrepresented;  // model terms the prediction leaves out (paths)
+};
+
+struct MonteCarloOutput {
+  MonteCarloStatistics statistics;
+  std::optional<CovarianceAnalysisResult> covariance;  // when spec.covariance
+  std::optional<FilterConsistencyData> consistency;    // when spec.filter == kInsGnssEkf
 };
 
 // Limits (memory and sanity).
@@ -129,6 +189,65 @@ struct MonteCarloProgress {
 // the workers stop within ~1024 samples and the function returns statistics with cancelled() ==
 // true and no runs, epochs or checkpoint values (timings are filled in).
 MonteCarloStatistics RunMonteCarlo(
+    const MonteCarloSpec& spec,
+    const std::function<void(const MonteCarloProgress&)>& progress = nullptr,
+    const std::atomic<bool>* cancel = nullptr);
+
+// The layout of one run, reported by ReplayMonteCarloRun before its first step.
+struct MonteCarloRunLayout {
+  const NavEnvironment* env = nullptr;  // the trajectory's Earth model (valid during the call)
+  double rate_hz = 0.0;                 // IMU rate [Hz]
+  double dt_s = 0.0;                    // IMU interval [s]
+  int64_t num_steps = 0;                // samples k = 0..num_steps
+  int64_t navigation_start_step = 0;    // s0: first sample with a navigation solution
+  size_t num_epochs = 0;                // output epochs of the statistics
+  size_t num_checkpoints = 0;           // checkpoints of the statistics (the last is the final)
+};
+
+// One IMU sample k of a replayed run (pointers valid during the callback only).
+struct MonteCarloRunStep {
+  int64_t k = 0;
+  const NavState* truth = nullptr;  // truth at t_k
+  // The run's measured IMU data: the increment over (t_{k-1}, t_k] (zero at k = 0) and the point
+  // sample at t_k, each from its own ImuErrorSimulator of (model, seed, run, rate) exactly as
+  // RunSimulation (simulate.h) makes them, so they equal `driftlab export --seed S --run R`.
+  const ImuIncrement* measured_increment = nullptr;
+  const ImuSample* measured_sample = nullptr;
+  // The run's navigation solution at t_k (the solution RunMonteCarlo scores), from s0 on and only
+  // when navigation was asked for; nullptr otherwise.
+  const NavState* nav = nullptr;
+  // Index of the output epoch / checkpoint at sample k, or -1; report_t_s = k dt_s as the
+  // statistics report it (MonteCarloStatisticsData::epoch_times_s, CheckpointValues::t_s).
+  int epoch = -1;
+  int checkpoint = -1;
+  double report_t_s = 0.0;
+};
+
+// Replays run `run` of the job sample by sample exactly as RunMonteCarlo computes it: the same
+// truth, the run's sensor errors from RandomStream(seed, run, ...), its initial errors, alignment
+// and mechanization (spec.first_run / run_count are ignored; run < spec.runs is required). For
+// users who bring their own navigation algorithm (the gRPC Datasets service): the errors of the
+// steps' `nav` against their `truth` at the epochs are the numbers RunMonteCarlo accumulates for
+// this run. Validation as RunMonteCarlo (SpecError; "monte_carlo.first_run" for run >= runs;
+// "navigation.filter" when navigate is asked for a job with a filter: the replay navigates with
+// the free-inertial mechanization only).
+// `cancel` is polled every 1024 samples; returns false when it stopped the replay, else true.
+// Memory O(epochs); not a hot path (one std::function call per sample).
+bool ReplayMonteCarloRun(const MonteCarloSpec& spec, uint32_t run, bool navigate,
+                         const std::function<void(const MonteCarloRunLayout&)>& on_start,
+                         const std::function<void(const MonteCarloRunStep&)>& on_step,
+                         const std::atomic<bool>* cancel = nullptr);
+
+// The checks of the filter, aiding and covariance fields that need no trajectory (RunMonteCarlo
+// makes them too; exposed so that a job can be rejected before it is queued). Throws SpecError.
+void ValidateFilterAndAiding(const MonteCarloSpec& spec);
+
+// RunMonteCarlo plus, when the spec asks for them, the linear covariance analysis of the same
+// error model at the output epochs (computed once, after the runs; not for a cancelled job) and
+// the EKF's NEES sums. Validation as RunMonteCarlo, plus "navigation.filter",
+// "monte_carlo.covariance", "aiding..." paths for filter, analysis and aiding combinations that
+// do not fit.
+MonteCarloOutput RunMonteCarloWithAnalysis(
     const MonteCarloSpec& spec,
     const std::function<void(const MonteCarloProgress&)>& progress = nullptr,
     const std::atomic<bool>* cancel = nullptr);

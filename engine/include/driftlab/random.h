@@ -52,6 +52,7 @@ enum class SensorId : uint8_t {
   kGnss = 4,
   kOdometer = 5,
   kInitialConditions = 6,  // per-run initial navigation errors
+  kZeroVelocity = 7,       // residual motion of a standing vehicle (ZUPT measurement noise)
 };
 
 // Which error term a stream drives. `component` (StreamKey) distinguishes several streams of one

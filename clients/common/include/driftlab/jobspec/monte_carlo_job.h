@@ -33,6 +33,8 @@ struct MonteCarloOverrides {
   // Shard i of K (`--shard i/K`): runs [floor(i N / K), floor((i + 1) N / K)).
   std::optional<uint32_t> shard_index;
   std::optional<uint32_t> shard_count;
+  // `run --covariance`: add the linear covariance analysis (as monte_carlo.covariance = true).
+  bool covariance = false;
 };
 
 // Parses "i/K" (`--shard`); throws SpecError("--shard", text, "i/K with 0 <= i < K, K >= 1").
@@ -43,6 +45,10 @@ void ParseShard(const std::string& text, MonteCarloOverrides* overrides);
 // initialization, epochs, checkpoints) and the overrides. Throws SpecError naming the field
 // ("monte_carlo.epoch_interval_s", "--runs", "--shard", ...). The engine checks the rest when it
 // runs (epochs outside the trajectory, alignment over a moving segment) with the same field paths.
+// Also navigation.filter / ekf / complementary and aiding (GNSS, barometer, magnetometer, ZUPT):
+// every number range-checked ("aiding.gnss.position_sigma_ned_m[2]"), outages ascending, not
+// overlapping and inside the trajectory ("aiding.gnss.outages[1].start_s" / ".end_s"), aiding
+// rates at most the IMU rate and dividing it, each aid only with the filter that uses it.
 MonteCarloSpec ToMonteCarloSpec(const JobFile& file, const MonteCarloOverrides& overrides);
 
 // The job as run: the job file's message with the overrides written into monte_carlo (runs,
@@ -52,6 +58,11 @@ v1::Job JobAsRun(const v1::Job& job, const MonteCarloSpec& spec);
 // The result of a (shard of a) job. `cpu_s` is the process CPU time when measured (< 0: absent).
 // Throws SpecError for a cancelled job or runs that are not one contiguous range.
 v1::JobResult ToJobResult(const v1::Job& job_as_run, const MonteCarloStatistics& statistics,
+                          const std::string& engine_version, double cpu_s = -1.0);
+// The same with the analyses of RunMonteCarloWithAnalysis: `covariance` (predicted sigma per
+// epoch, in the result's units and component order) and `filter_consistency` (average NEES per
+// epoch with its chi-square 95 % bounds; its exact sums go to merge_state for `merge`).
+v1::JobResult ToJobResult(const v1::Job& job_as_run, const MonteCarloOutput& output,
                           const std::string& engine_version, double cpu_s = -1.0);
 
 // Fills each checkpoint's percentiles, CEP50/95, 2DRMS and maxima from its per-run values.
