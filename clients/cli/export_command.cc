@@ -3,6 +3,12 @@
 // and point samples), imu_ideal.csv (the error-free data), truth.csv (the reference trajectory),
 // truth_groves.csv (the same in Groves' profile layout) and run.txt (what was run). The job is
 // validated completely before DIR is created.
+//
+// With `--server ADDR [--token T] [--tls-ca F]` the server simulates the run (Datasets.ExportRun)
+// and streams it: imu.csv and truth.csv (the same columns and numbers as the local files: the
+// engine's CSV writer prints each double as the shortest text that reads back exactly),
+// navigation.csv with --navigation (the engine's own navigation solution of that run, the layout
+// `driftlab score` reads) and run.txt.
 #include <fmt/format.h>
 #include <fmt/os.h>
 
@@ -10,8 +16,10 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <system_error>
+#include <vector>
 
 #include "commands.h"
 #include "driftlab/io.h"
@@ -20,6 +28,7 @@
 #include "driftlab/jobspec/translate.h"
 #include "driftlab/simulate.h"
 #include "driftlab/spec_error.h"
+#include "remote_client.h"
 
 namespace driftlab::cli {
 namespace {
@@ -29,9 +38,145 @@ struct ExportOptions {
   std::string out_dir;
   std::optional<uint64_t> seed;
   uint32_t run_index = 0;
+  bool navigation = false;
+  RemoteOptions remote;
 };
 
+// A CSV file of rows of doubles under a header of column names, printed by the engine's writer.
+class RowsCsvWriter : public CsvFile {
+ public:
+  // The engine's row buffer holds 20 numbers; the export layouts have at most 13 columns.
+  static constexpr int kMaxColumns = 20;
+
+  RowsCsvWriter(const std::filesystem::path& path, const std::vector<std::string>& columns)
+      : CsvFile(path, fmt::format("{}", fmt::join(columns, ","))),
+        columns_(static_cast<int>(columns.size())) {}
+
+  // Writes values.size() / columns rows; `what` names the stream in errors.
+  void WriteRows(const google::protobuf::RepeatedField<double>& values, const std::string& what) {
+    if (columns_ == 0 || values.size() % columns_ != 0) {
+      throw std::runtime_error(fmt::format("{}: chunk of {} values is not a multiple of {} columns",
+                                           what, values.size(), columns_));
+    }
+    for (int i = 0; i < values.size(); i += columns_) Row(values.data() + i, columns_);
+    rows_ += static_cast<uint64_t>(values.size() / columns_);
+  }
+  uint64_t rows() const { return rows_; }
+
+ private:
+  int columns_;
+  uint64_t rows_ = 0;
+};
+
+void CheckColumns(const google::protobuf::RepeatedPtrField<std::string>& columns,
+                  const std::string& what) {
+  if (columns.empty() || columns.size() > RowsCsvWriter::kMaxColumns) {
+    throw std::runtime_error(fmt::format("the server sent {} {} columns; expected 1 to {}",
+                                         columns.size(), what, RowsCsvWriter::kMaxColumns));
+  }
+}
+
+int RunRemoteExport(const ExportOptions& options) {
+  v1::ExportRunRequest request;
+  std::unique_ptr<v1::Datasets::Stub> stub;
+  try {
+    v1::RunRef* run = request.mutable_run();
+    *run->mutable_job() = jobspec::LoadJobFile(options.job_path).job;
+    if (options.seed) run->set_seed(*options.seed);
+    run->set_run_index(options.run_index);
+    request.set_include_navigation(options.navigation);
+    stub = v1::Datasets::NewStub(MakeChannel(options.remote));
+  } catch (const SpecError& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return kExitBadJob;
+  }
+  const uint64_t seed = options.seed.value_or(jobspec::JobSeed(request.run().job()));
+
+  grpc::ClientContext context;
+  PrepareContext(options.remote, &context);
+  std::unique_ptr<grpc::ClientReader<v1::ExportRunResponse>> reader =
+      stub->ExportRun(&context, request);
+  const std::filesystem::path dir(options.out_dir);
+  v1::ExportRunResponse response;
+  std::optional<v1::ExportHeader> header;
+  std::unique_ptr<RowsCsvWriter> imu, truth, navigation;
+  try {
+    while (reader->Read(&response)) {
+      if (response.has_header()) {
+        if (header) throw std::runtime_error("the server sent a second export header");
+        header = response.header();
+        CheckColumns(header->imu_columns(), "IMU");
+        CheckColumns(header->truth_columns(), "truth");
+        if (options.navigation) CheckColumns(header->navigation_columns(), "navigation");
+        std::filesystem::create_directories(dir);
+        const std::vector<std::string> imu_columns(header->imu_columns().begin(),
+                                                   header->imu_columns().end());
+        const std::vector<std::string> truth_columns(header->truth_columns().begin(),
+                                                     header->truth_columns().end());
+        imu = std::make_unique<RowsCsvWriter>(dir / "imu.csv", imu_columns);
+        truth = std::make_unique<RowsCsvWriter>(dir / "truth.csv", truth_columns);
+        if (options.navigation) {
+          const std::vector<std::string> navigation_columns(header->navigation_columns().begin(),
+                                                            header->navigation_columns().end());
+          navigation = std::make_unique<RowsCsvWriter>(dir / "navigation.csv", navigation_columns);
+        }
+        continue;
+      }
+      if (!header) throw std::runtime_error("the server sent rows before the export header");
+      const v1::ExportChunk& chunk = response.chunk();
+      imu->WriteRows(chunk.imu(), "imu");
+      truth->WriteRows(chunk.truth(), "truth");
+      if (navigation) {
+        navigation->WriteRows(chunk.navigation(), "navigation");
+      } else if (!chunk.navigation().empty()) {
+        throw std::runtime_error("the server sent navigation rows that were not asked for");
+      }
+    }
+  } catch (const std::exception& e) {
+    context.TryCancel();
+    reader->Finish();
+    fmt::print(stderr, "error: {}: {}\n", options.remote.server, e.what());
+    return kExitFailure;
+  }
+  const grpc::Status status = reader->Finish();
+  if (!status.ok()) return ReportRpcError(status, options.remote);
+  try {
+    if (!header) throw std::runtime_error("the export stream ended without a header");
+    auto check_rows = [](const RowsCsvWriter& writer, uint64_t expected, const char* name) {
+      if (writer.rows() != expected) {
+        throw std::runtime_error(fmt::format("{}: {} rows received, the header announced {}", name,
+                                             writer.rows(), expected));
+      }
+    };
+    check_rows(*imu, header->imu_rows(), "imu.csv");
+    check_rows(*truth, header->truth_rows(), "truth.csv");
+    imu->Close();
+    truth->Close();
+    if (navigation) {
+      check_rows(*navigation, header->navigation_rows(), "navigation.csv");
+      navigation->Close();
+    }
+    {
+      auto run = fmt::output_file((dir / "run.txt").string());
+      run.print("job: {}\nname: {}\nserver: {}\nseed: {}\nrun: {}\nrate_hz: {:.17g}\n",
+                options.job_path, request.run().job().name(), options.remote.server, seed,
+                options.run_index, header->rate_hz());
+      run.print("samples: {}\n", header->imu_rows());
+    }
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return kExitFailure;
+  }
+  fmt::print("{}: seed {}, run {}: {} samples at {:g} Hz (from {})\n",
+             request.run().job().name().empty() ? "(unnamed)" : request.run().job().name(), seed,
+             options.run_index, header->imu_rows(), header->rate_hz(), options.remote.server);
+  fmt::print("wrote imu.csv, truth.csv, {}run.txt to {}\n",
+             options.navigation ? "navigation.csv, " : "", dir.string());
+  return kExitOk;
+}
+
 int RunExport(const ExportOptions& options) {
+  if (!options.remote.server.empty()) return RunRemoteExport(options);
   jobspec::JobFile file;
   SimulationSpec spec;
   std::optional<SensorRun> sensor;
@@ -110,6 +255,12 @@ const RegisterCommand kExport("export", [](CLI::App& app) -> std::function<int()
       ->required();
   command->add_option("--seed", options->seed, "Random seed (default: the job's monte_carlo.seed)");
   command->add_option("--run", options->run_index, "Run index")->capture_default_str();
+  CLI::Option* server = AddRemoteOptions(command, &options->remote, /*server_required=*/false);
+  command
+      ->add_flag("--navigation", options->navigation,
+                 "Also write navigation.csv, the engine's navigation solution of this run "
+                 "(with --server)")
+      ->needs(server);
   return [options] { return RunExport(*options); };
 });
 

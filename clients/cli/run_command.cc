@@ -6,6 +6,11 @@
 // Progress goes to stderr: a bar redrawn in place when stderr is a terminal, otherwise a plain
 // line at every 10 % of the runs. Ctrl-C (SIGINT) or SIGTERM cancels the job: the engine stops
 // within about 1024 samples per worker, nothing is written, and the exit status is 130.
+//
+// With `--server ADDR [--token T] [--tls-ca F]` the job runs on a driftlab-server instead: it is
+// submitted (Jobs.Submit, validated by the server exactly as here), the progress bar follows
+// Jobs.Watch, and the result (Jobs.GetResult) is printed and written exactly as a local result;
+// Ctrl-C while watching cancels the remote job (Jobs.Cancel), nothing is written, exit status 130.
 #include <fmt/format.h>
 #include <sys/resource.h>
 #include <unistd.h>
@@ -27,11 +32,12 @@
 #include "driftlab/jobspec/result_file.h"
 #include "driftlab/monte_carlo.h"
 #include "driftlab/spec_error.h"
+#include "progress.h"
+#include "remote.h"
+#include "run_output.h"
 
 namespace driftlab::cli {
 namespace {
-
-constexpr int kExitCancelled = 130;  // 128 + SIGINT, the shell convention
 
 std::atomic<bool> g_cancel{false};
 extern "C" void OnSignal(int) { g_cancel.store(true); }
@@ -43,42 +49,7 @@ double ProcessCpuSeconds() {
   return seconds(usage.ru_utime) + seconds(usage.ru_stime);
 }
 
-// Progress on stderr: a bar on a terminal, plain lines at every 10 % otherwise.
-class ProgressPrinter {
- public:
-  ProgressPrinter() : terminal_(isatty(STDERR_FILENO) == 1) {}
-
-  void Update(const MonteCarloProgress& p) {
-    if (p.runs_total == 0) return;
-    const double fraction = static_cast<double>(p.runs_done) / p.runs_total;
-    const double rate = p.elapsed_s > 0 ? p.samples_done / p.elapsed_s : 0.0;
-    if (terminal_) {
-      constexpr int kWidth = 30;
-      const int filled = static_cast<int>(fraction * kWidth);
-      const double eta_s =
-          rate > 0 ? static_cast<double>(p.samples_total - p.samples_done) / rate : 0.0;
-      fmt::print(stderr, "\r[{:<{}}] {:3.0f}% {}/{} runs  {:.2f} M samples/s  ETA {:.0f} s ",
-                 std::string(filled, '#'), kWidth, 100 * fraction, p.runs_done, p.runs_total,
-                 rate / 1e6, eta_s);
-      drawn_ = true;
-    } else {
-      const int decile = static_cast<int>(fraction * 10);
-      if (decile > last_decile_) {
-        last_decile_ = decile;
-        fmt::print(stderr, "progress: {:3d}% ({}/{} runs, {:.1f} s, {:.2f} M samples/s)\n",
-                   decile * 10, p.runs_done, p.runs_total, p.elapsed_s, rate / 1e6);
-      }
-    }
-  }
-  void Finish() {
-    if (drawn_) fmt::print(stderr, "\n");
-  }
-
- private:
-  bool terminal_;
-  bool drawn_ = false;
-  int last_decile_ = 0;
-};
+}  // namespace
 
 void PrintFinalSummary(const v1::JobResult& result) {
   const v1::EpochStatistics& final_epoch = result.epochs(result.epochs_size() - 1);
@@ -123,6 +94,8 @@ void WriteOutputs(const v1::JobResult& result, const std::string& out,
   }
 }
 
+namespace {
+
 struct RunOptions {
   std::string job_path;
   std::string out;
@@ -132,9 +105,21 @@ struct RunOptions {
   std::optional<int> threads;
   std::optional<std::string> shard;
   bool quiet = false;
+  bool covariance = false;
+  RemoteOptions remote;
 };
 
 int RunRun(const RunOptions& options) {
+  if (!options.remote.server.empty()) {
+    if (options.threads) {
+      fmt::print(stderr,
+                 "note: --threads is not used with --server (the server sets each job's "
+                 "threads)\n");
+    }
+    return RunRemoteJob(options.remote,
+                        {options.job_path, options.runs, options.seed, options.shard, options.out,
+                         options.report, options.quiet, options.covariance});
+  }
   jobspec::JobFile file;
   MonteCarloSpec spec;
   try {
@@ -143,6 +128,7 @@ int RunRun(const RunOptions& options) {
     overrides.runs = options.runs;
     overrides.seed = options.seed;
     overrides.threads = options.threads;
+    overrides.covariance = options.covariance;
     if (options.shard) jobspec::ParseShard(*options.shard, &overrides);
     spec = jobspec::ToMonteCarloSpec(file, overrides);
   } catch (const SpecError& e) {
@@ -154,9 +140,9 @@ int RunRun(const RunOptions& options) {
   std::signal(SIGTERM, OnSignal);
   ProgressPrinter printer;
   const double cpu0_s = ProcessCpuSeconds();
-  MonteCarloStatistics statistics;
+  MonteCarloOutput output;
   try {
-    statistics = RunMonteCarlo(
+    output = RunMonteCarloWithAnalysis(
         spec,
         [&printer, &options](const MonteCarloProgress& p) {
           if (!options.quiet) printer.Update(p);
@@ -168,14 +154,14 @@ int RunRun(const RunOptions& options) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;
   }
-  if (statistics.cancelled()) {
+  if (output.statistics.cancelled()) {
     fmt::print(stderr, "cancelled: nothing written\n");
     return kExitCancelled;
   }
   const double cpu_s = ProcessCpuSeconds() - cpu0_s;
   try {
-    const v1::JobResult result = jobspec::ToJobResult(jobspec::JobAsRun(file.job, spec), statistics,
-                                                      DRIFTLAB_VERSION, cpu_s);
+    const v1::JobResult result =
+        jobspec::ToJobResult(jobspec::JobAsRun(file.job, spec), output, DRIFTLAB_VERSION, cpu_s);
     PrintFinalSummary(result);
     WriteOutputs(result, options.out, options.report);
   } catch (const std::exception& e) {
@@ -226,6 +212,10 @@ const RegisterCommand kRun("run", [](CLI::App& app) -> std::function<int()> {
   command->add_option("--shard", options->shard,
                       "Run only shard i of K (i/K, 0 <= i < K); combine with `driftlab merge`");
   command->add_flag("--quiet,-q", options->quiet, "No progress output");
+  command->add_flag(
+      "--covariance", options->covariance,
+      "Add the linear covariance analysis (predicted sigma of every error component)");
+  AddRemoteOptions(command, &options->remote, /*server_required=*/false);
   return [options] { return RunRun(*options); };
 });
 

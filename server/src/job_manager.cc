@@ -1,0 +1,666 @@
+#include "driftlab/server/job_manager.h"
+
+#include <google/protobuf/io/coded_stream.h>
+#include <google/protobuf/io/zero_copy_stream_impl_lite.h>
+#include <openssl/rand.h>
+#include <spdlog/spdlog.h>
+#include <tbb/info.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "driftlab/jobspec/job_file.h"
+#include "driftlab/jobspec/monte_carlo_job.h"
+#include "driftlab/spec_error.h"
+#include "driftlab/trajectory.h"
+
+namespace driftlab::server {
+namespace {
+
+using google::protobuf::FieldDescriptor;
+using google::protobuf::Message;
+using google::protobuf::Reflection;
+using SteadyClock = std::chrono::steady_clock;
+
+// Largest accepted deadline_s: one year.
+constexpr double kMaxDeadline_s = 365.0 * 86400.0;
+constexpr uint32_t kDefaultPageSize = 100;
+constexpr uint32_t kMaxPageSize = 1000;
+// Cancel waits this long for the worker to stop; the engine stops within 1024 samples per worker
+// (milliseconds), so reaching it means a stuck worker, reported as an error.
+constexpr std::chrono::seconds kCancelWait{10};
+
+double UnixNow() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+std::string NewJobId() {
+  unsigned char bytes[12];
+  if (RAND_bytes(bytes, sizeof(bytes)) != 1) throw std::runtime_error("RAND_bytes failed");
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string id = "job-";
+  for (unsigned char b : bytes) {
+    id.push_back(kHex[b >> 4]);
+    id.push_back(kHex[b & 15]);
+  }
+  return id;
+}
+
+std::string FieldPath(const std::string& path, const FieldDescriptor& field, int index) {
+  std::string out = path.empty() ? field.name() : path + "." + field.name();
+  if (index >= 0) out += "[" + std::to_string(index) + "]";
+  return out;
+}
+
+std::string AllowedEnumNames(const google::protobuf::EnumDescriptor& type) {
+  std::string names;
+  for (int i = 0; i < type.value_count(); ++i) {
+    if (i) names += ", ";
+    names += type.value(i)->name();
+  }
+  return names;
+}
+
+void CheckFieldValue(const Message& message, const FieldDescriptor& field, int index,
+                     const std::string& path) {
+  const Reflection& r = *message.GetReflection();
+  const bool repeated = field.is_repeated();
+  switch (field.cpp_type()) {
+    case FieldDescriptor::CPPTYPE_ENUM: {
+      const int value = repeated ? r.GetRepeatedEnumValue(message, &field, index)
+                                 : r.GetEnumValue(message, &field);
+      if (field.enum_type()->FindValueByNumber(value) == nullptr) {
+        throw SpecError(FieldPath(path, field, index), std::to_string(value),
+                        AllowedEnumNames(*field.enum_type()));
+      }
+      break;
+    }
+    case FieldDescriptor::CPPTYPE_DOUBLE:
+    case FieldDescriptor::CPPTYPE_FLOAT: {
+      double value = 0;
+      if (field.cpp_type() == FieldDescriptor::CPPTYPE_DOUBLE) {
+        value =
+            repeated ? r.GetRepeatedDouble(message, &field, index) : r.GetDouble(message, &field);
+      } else {
+        value = repeated ? r.GetRepeatedFloat(message, &field, index) : r.GetFloat(message, &field);
+      }
+      if (!std::isfinite(value)) {
+        throw SpecError(FieldPath(path, field, index),
+                        std::isnan(value) ? "NaN" : (value > 0 ? "Infinity" : "-Infinity"),
+                        "a finite number");
+      }
+      break;
+    }
+    case FieldDescriptor::CPPTYPE_MESSAGE:
+      CheckMessageValues(
+          repeated ? r.GetRepeatedMessage(message, &field, index) : r.GetMessage(message, &field),
+          FieldPath(path, field, index));
+      break;
+    default:
+      break;
+  }
+}
+
+}  // namespace
+
+void CheckMessageValues(const Message& message, const std::string& path) {
+  const Reflection& r = *message.GetReflection();
+  if (!r.GetUnknownFields(message).empty()) {
+    const auto& unknown = r.GetUnknownFields(message);
+    throw SpecError(path.empty() ? "(job)" : path,
+                    "unknown field number " + std::to_string(unknown.field(0).number()),
+                    "the fields of " + message.GetDescriptor()->full_name());
+  }
+  std::vector<const FieldDescriptor*> fields;
+  r.ListFields(message, &fields);  // set fields, in field-number order
+  for (const FieldDescriptor* field : fields) {
+    if (field->is_map()) continue;
+    if (field->is_repeated()) {
+      for (int i = 0; i < r.FieldSize(message, field); ++i) {
+        CheckFieldValue(message, *field, i, path);
+      }
+    } else {
+      CheckFieldValue(message, *field, -1, path);
+    }
+  }
+}
+
+std::string SerializeDeterministic(const Message& message) {
+  std::string bytes;
+  {
+    google::protobuf::io::StringOutputStream stream(&bytes);
+    google::protobuf::io::CodedOutputStream coded(&stream);
+    coded.SetSerializationDeterministic(true);
+    message.SerializeToCodedStream(&coded);
+  }
+  return bytes;
+}
+
+ValidatedJob ValidateSubmitRequest(const v1::SubmitJobRequest& request, int threads_per_job) {
+  if (!request.has_job()) throw SpecError("job", "", "a job (motion, rate_hz, navigation, ...)");
+  CheckMessageValues(request.job());
+  const v1::Motion& motion = request.job().motion();
+  if (motion.has_gnss_ins_sim_file()) {
+    throw SpecError("motion.gnss_ins_sim_file.path",
+                    "\"" + motion.gnss_ins_sim_file().path() +
+                        "\": the server does not read files; inline the motion",
+                    0);
+  }
+  if (motion.has_truth_profile_file()) {
+    throw SpecError("motion.truth_profile_file.path",
+                    "\"" + motion.truth_profile_file().path() +
+                        "\": the server does not read files; inline the motion",
+                    0);
+  }
+  jobspec::MonteCarloOverrides overrides;
+  if (request.has_runs()) {
+    if (request.runs() < 1 || request.runs() > kMaxMonteCarloRuns) {
+      throw SpecError("runs", std::to_string(request.runs()),
+                      "1 to " + std::to_string(kMaxMonteCarloRuns));
+    }
+    overrides.runs = request.runs();
+  }
+  if (request.has_seed()) overrides.seed = request.seed();
+  if (!request.shard().empty()) {
+    try {
+      jobspec::ParseShard(request.shard(), &overrides);
+    } catch (const SpecError&) {
+      throw SpecError("shard", "\"" + request.shard() + "\"", "i/K with 0 <= i < K, K >= 1");
+    }
+  }
+  if (request.has_deadline_s()) {
+    const double d = request.deadline_s();
+    if (!(d >= 0.0 && d <= kMaxDeadline_s)) {
+      throw SpecError("deadline_s", std::isnan(d) ? "NaN" : fmt::format("{}", d),
+                      fmt::format("0 (none) to {} s", kMaxDeadline_s));
+    }
+  }
+  overrides.threads = threads_per_job;
+
+  jobspec::JobFile file{request.job(), std::filesystem::path()};
+  ValidatedJob out;
+  out.spec = jobspec::ToMonteCarloSpec(file, overrides);
+  const MonteCarloSpec& spec = out.spec;
+  out.runs_total = spec.run_count == 0 ? spec.runs - spec.first_run : spec.run_count;
+  // Samples per run as the engine counts them (monte_carlo.cc): the generator's output steps, plus
+  // the initial sample for mechanization B, which consumes point samples from t = 0.
+  const TrajectoryGenerator generator(spec.simulation.motion, spec.simulation.rate_hz);
+  const uint64_t per_run = static_cast<uint64_t>(generator.num_steps()) +
+                           (spec.simulation.mechanization == MechanizationKind::kSeed000 ? 1 : 0);
+  out.samples_total = per_run * out.runs_total;
+  return out;
+}
+
+// ------------------------------------------------------------------------------------------------
+
+struct JobManager::LiveJob {
+  StoredJob row;  // mirror of the store's row
+  std::atomic<bool> cancel{false};
+  CancelReason reason = CancelReason::kNone;  // guarded by mutex_
+  bool running = false;
+  MonteCarloProgress progress;
+  SteadyClock::time_point started;
+  uint64_t version = 0;  // bumped at every change Watch reports
+};
+
+namespace {
+
+void FillStatus(const StoredJob& row, v1::JobStatus* status) {
+  status->set_job_id(row.id);
+  status->set_state(row.state);
+  status->set_name(row.name);
+  status->set_runs_total(row.runs_total);
+  status->set_samples_total(row.samples_total);
+  status->set_error(row.error);
+  status->set_submitted_unix_s(row.submitted_unix_s);
+  if (row.started_unix_s) status->set_started_unix_s(*row.started_unix_s);
+  if (row.finished_unix_s) status->set_finished_unix_s(*row.finished_unix_s);
+  status->set_attempts(row.attempts);
+  if (row.state == v1::SUCCEEDED) {
+    status->set_runs_done(row.runs_total);
+    status->set_samples_done(row.samples_total);
+  }
+  if (row.started_unix_s && row.finished_unix_s) {
+    status->set_elapsed_s(*row.finished_unix_s - *row.started_unix_s);
+  }
+}
+
+grpc::Status NotFound(const std::string& job_id) {
+  return grpc::Status(grpc::StatusCode::NOT_FOUND, "job " + job_id + " not found");
+}
+
+}  // namespace
+
+JobManager::JobManager(JobStore* store, const ServerLimits& limits, std::string version)
+    : store_(store), limits_(limits), version_(std::move(version)) {
+  limits_.max_concurrent_jobs = std::max<uint32_t>(1, limits_.max_concurrent_jobs);
+  threads_per_job_ = limits_.threads_per_job > 0
+                         ? limits_.threads_per_job
+                         : std::max(1, tbb::info::default_concurrency() /
+                                           static_cast<int>(limits_.max_concurrent_jobs));
+  start_time_ = SteadyClock::now();
+}
+
+JobManager::~JobManager() { Shutdown(std::chrono::milliseconds(0)); }
+
+void JobManager::Start() {
+  const std::vector<StoredJob> queued = store_->RecoverQueued();
+  {
+    std::lock_guard lock(mutex_);
+    for (const StoredJob& row : queued) {
+      auto live = std::make_shared<LiveJob>();
+      live->row = row;
+      live_[row.id] = live;
+      queue_.push_back(row.id);
+      ++queued_by_owner_[row.owner];
+    }
+    accepting_ = true;
+  }
+  if (!queued.empty()) spdlog::info("recovered {} queued job(s) from the store", queued.size());
+  for (uint32_t i = 0; i < limits_.max_concurrent_jobs; ++i) {
+    workers_.emplace_back([this] { WorkerLoop(); });
+  }
+  deadline_thread_ = std::thread([this] { DeadlineLoop(); });
+}
+
+void JobManager::Shutdown(std::chrono::milliseconds grace) {
+  std::unique_lock lock(mutex_);
+  if (stopped_) return;
+  accepting_ = false;
+  draining_ = true;
+  changed_.notify_all();
+  const auto any_running = [this] {
+    return std::any_of(live_.begin(), live_.end(), [](const auto& e) { return e.second->running; });
+  };
+  if (any_running()) {
+    spdlog::info("shutdown: waiting up to {} ms for running jobs", grace.count());
+    changed_.wait_for(lock, grace, [&] { return !any_running(); });
+  }
+  for (auto& [id, live] : live_) {
+    if (live->running) {
+      live->reason = CancelReason::kShutdown;
+      live->cancel.store(true);
+    }
+  }
+  lock.unlock();
+  for (std::thread& worker : workers_) worker.join();
+  workers_.clear();
+  lock.lock();
+  stopped_ = true;
+  changed_.notify_all();
+  lock.unlock();
+  if (deadline_thread_.joinable()) deadline_thread_.join();
+}
+
+grpc::Status JobManager::Submit(const std::string& owner, const v1::SubmitJobRequest& request,
+                                v1::JobStatus* status) {
+  ValidatedJob job;
+  try {
+    job = ValidateSubmitRequest(request, threads_per_job_);
+  } catch (const SpecError& e) {
+    spdlog::info("submit rejected: owner={} error=\"{}\"", owner, e.what());
+    return InvalidArgument(e);
+  }
+  if (job.samples_total > limits_.max_job_samples) {
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                        fmt::format("job cost: {} runs x {} samples = {} samples exceeds the "
+                                    "server's limit of {} (--max-job-samples)",
+                                    job.runs_total, job.samples_total / job.runs_total,
+                                    job.samples_total, limits_.max_job_samples));
+  }
+  auto live = std::make_shared<LiveJob>();
+  StoredJob& row = live->row;
+  row.id = NewJobId();
+  row.owner = owner;
+  row.request = SerializeDeterministic(request);
+  row.name = request.job().name();
+  row.runs_total = job.runs_total;
+  row.samples_total = job.samples_total;
+  row.submitted_unix_s = UnixNow();
+  if (request.deadline_s() > 0) row.deadline_unix_s = row.submitted_unix_s + request.deadline_s();
+
+  std::lock_guard lock(mutex_);
+  if (!accepting_) {
+    return grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down");
+  }
+  uint32_t& queued = queued_by_owner_[owner];
+  if (queued >= limits_.max_queued_jobs) {
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
+                        fmt::format("{} jobs of owner {} are queued; the server's limit is {} "
+                                    "(--max-queued-jobs)",
+                                    queued, owner, limits_.max_queued_jobs));
+  }
+  store_->Insert(&row);
+  ++queued;
+  live_[row.id] = live;
+  queue_.push_back(row.id);
+  spdlog::info("job={} owner={} state=QUEUED runs={} samples={} name=\"{}\"", row.id, owner,
+               row.runs_total, row.samples_total, row.name);
+  *status = LiveStatus(*live);
+  changed_.notify_all();
+  return grpc::Status::OK;
+}
+
+v1::JobStatus JobManager::LiveStatus(const LiveJob& live) const {
+  v1::JobStatus status;
+  FillStatus(live.row, &status);
+  if (live.running) {
+    status.set_runs_done(live.progress.runs_done);
+    status.set_samples_done(static_cast<uint64_t>(live.progress.samples_done));
+    const double elapsed = std::chrono::duration<double>(SteadyClock::now() - live.started).count();
+    status.set_elapsed_s(elapsed);
+    if (live.progress.elapsed_s > 0) {
+      status.set_samples_per_s(live.progress.samples_done / live.progress.elapsed_s);
+    }
+  } else {
+    status.set_runs_done(0);
+    status.set_samples_done(0);
+  }
+  return status;
+}
+
+grpc::Status JobManager::Get(const std::string& owner, const std::string& job_id,
+                             v1::JobStatus* status) {
+  {
+    std::lock_guard lock(mutex_);
+    const auto it = live_.find(job_id);
+    if (it != live_.end()) {
+      if (it->second->row.owner != owner) return NotFound(job_id);
+      *status = LiveStatus(*it->second);
+      return grpc::Status::OK;
+    }
+  }
+  const std::optional<StoredJob> row = store_->Get(job_id);
+  if (!row || row->owner != owner) return NotFound(job_id);
+  status->Clear();
+  FillStatus(*row, status);
+  return grpc::Status::OK;
+}
+
+void JobManager::DropQueuedLocked(const std::string& job_id) {
+  const auto it = live_.find(job_id);
+  if (it == live_.end()) return;
+  queue_.erase(std::remove(queue_.begin(), queue_.end(), job_id), queue_.end());
+  uint32_t& queued = queued_by_owner_[it->second->row.owner];
+  if (queued > 0) --queued;
+  live_.erase(it);
+}
+
+void JobManager::CancelQueuedLocked(const std::shared_ptr<LiveJob>& live,
+                                    const std::string& error) {
+  store_->MarkFinished(live->row.id, v1::CANCELLED, error, UnixNow());
+  spdlog::info("job={} owner={} state=CANCELLED runs=0 seconds=0 error=\"{}\"", live->row.id,
+               live->row.owner, error);
+  DropQueuedLocked(live->row.id);
+  changed_.notify_all();
+}
+
+grpc::Status JobManager::Cancel(const std::string& owner, const std::string& job_id,
+                                v1::JobStatus* status) {
+  {
+    std::unique_lock lock(mutex_);
+    const auto it = live_.find(job_id);
+    if (it != live_.end()) {
+      std::shared_ptr<LiveJob> live = it->second;
+      if (live->row.owner != owner) return NotFound(job_id);
+      if (!live->running) {
+        CancelQueuedLocked(live, "cancelled by its owner");
+      } else {
+        if (live->reason == CancelReason::kNone) live->reason = CancelReason::kOwner;
+        live->cancel.store(true);
+        const bool stopped =
+            changed_.wait_for(lock, kCancelWait, [&] { return live_.find(job_id) == live_.end(); });
+        if (!stopped) {
+          return grpc::Status(grpc::StatusCode::INTERNAL,
+                              "job " + job_id + " did not stop within 10 s of its cancellation");
+        }
+      }
+    }
+  }
+  return Get(owner, job_id, status);
+}
+
+grpc::Status JobManager::GetResult(const std::string& owner, const std::string& job_id,
+                                   v1::JobResult* result) {
+  v1::JobStatus status;
+  grpc::Status s = Get(owner, job_id, &status);
+  if (!s.ok()) return s;
+  if (status.state() != v1::SUCCEEDED) {
+    return grpc::Status(grpc::StatusCode::FAILED_PRECONDITION,
+                        "job " + job_id + " is " + v1::JobState_Name(status.state()) +
+                            "; a result exists only for SUCCEEDED jobs");
+  }
+  const std::optional<std::string> bytes = store_->GetResult(job_id);
+  if (!bytes || !result->ParseFromString(*bytes)) {
+    return grpc::Status(grpc::StatusCode::DATA_LOSS,
+                        "the stored result of " + job_id + " cannot be read");
+  }
+  return grpc::Status::OK;
+}
+
+grpc::Status JobManager::List(const std::string& owner, const v1::ListJobsRequest& request,
+                              v1::ListJobsResponse* response) {
+  uint32_t page_size = request.page_size() == 0 ? kDefaultPageSize : request.page_size();
+  if (page_size > kMaxPageSize) {
+    return InvalidArgument(SpecError("page_size", std::to_string(request.page_size()),
+                                     "0 (= 100) to " + std::to_string(kMaxPageSize)));
+  }
+  std::vector<v1::JobState> states;
+  for (int s : request.states()) {
+    if (!v1::JobState_IsValid(s) || s == v1::JOB_STATE_UNSPECIFIED) {
+      return InvalidArgument(
+          SpecError("states", std::to_string(s), "QUEUED, RUNNING, SUCCEEDED, FAILED, CANCELLED"));
+    }
+    states.push_back(static_cast<v1::JobState>(s));
+  }
+  int64_t before_seq = 0;
+  if (!request.page_token().empty()) {
+    const std::string& token = request.page_token();
+    const bool digits = std::all_of(token.begin(), token.end(), ::isdigit) && token.size() < 19;
+    if (!digits || (before_seq = std::stoll(token)) <= 0) {
+      return InvalidArgument(
+          SpecError("page_token", "\"" + token + "\"", "the next_page_token of the previous page"));
+    }
+  }
+  const std::vector<StoredJob> rows = store_->List(owner, states, before_seq, page_size + 1);
+  std::lock_guard lock(mutex_);
+  for (size_t i = 0; i < rows.size() && i < page_size; ++i) {
+    const auto it = live_.find(rows[i].id);
+    if (it != live_.end()) {
+      *response->add_jobs() = LiveStatus(*it->second);
+    } else {
+      FillStatus(rows[i], response->add_jobs());
+    }
+  }
+  if (rows.size() > page_size)
+    response->set_next_page_token(std::to_string(rows[page_size - 1].seq));
+  return grpc::Status::OK;
+}
+
+void JobManager::Metrics(v1::ServerMetrics* metrics) {
+  for (const auto& [state, count] : store_->CountByState()) {
+    (*metrics->mutable_jobs_by_state())[v1::JobState_Name(state)] = count;
+  }
+  double rate = 0.0;
+  uint64_t samples = 0;
+  {
+    std::lock_guard lock(mutex_);
+    samples = samples_finished_;
+    for (const auto& [id, live] : live_) {
+      if (!live->running) continue;
+      samples += static_cast<uint64_t>(live->progress.samples_done);
+      if (live->progress.elapsed_s > 0)
+        rate += live->progress.samples_done / live->progress.elapsed_s;
+    }
+  }
+  metrics->set_samples_per_s(rate);
+  metrics->set_samples_total(samples);
+  metrics->set_max_concurrent_jobs(limits_.max_concurrent_jobs);
+  metrics->set_max_queued_jobs(limits_.max_queued_jobs);
+  metrics->set_max_job_samples(limits_.max_job_samples);
+  metrics->set_uptime_s(std::chrono::duration<double>(SteadyClock::now() - start_time_).count());
+  metrics->set_version(version_);
+}
+
+grpc::Status JobManager::Watch(const std::string& owner, const std::string& job_id,
+                               const std::function<bool(const v1::JobStatus&)>& send,
+                               const std::function<bool()>& cancelled,
+                               std::chrono::system_clock::time_point deadline) {
+  // How often a waiting Watch looks at the client's connection and deadline.
+  constexpr auto kPoll = std::chrono::milliseconds(50);
+  uint64_t sent_version = std::numeric_limits<uint64_t>::max();
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    const auto it = live_.find(job_id);
+    if (it == live_.end()) break;  // final (or never existed): answered from the store below
+    const std::shared_ptr<LiveJob> live = it->second;
+    if (live->row.owner != owner) return NotFound(job_id);
+    if (live->version != sent_version) {
+      sent_version = live->version;
+      const v1::JobStatus status = LiveStatus(*live);
+      lock.unlock();
+      if (!send(status)) return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
+      lock.lock();
+      continue;
+    }
+    if (stopped_) {
+      return grpc::Status(grpc::StatusCode::UNAVAILABLE, "the server is shutting down");
+    }
+    if (cancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "client cancelled");
+    if (std::chrono::system_clock::now() >= deadline) {
+      return grpc::Status(grpc::StatusCode::DEADLINE_EXCEEDED, "the call's deadline passed");
+    }
+    changed_.wait_for(lock, kPoll);
+  }
+  lock.unlock();
+  const std::optional<StoredJob> row = store_->Get(job_id);
+  if (!row || row->owner != owner) return NotFound(job_id);
+  v1::JobStatus status;
+  FillStatus(*row, &status);
+  if (!send(status)) return grpc::Status(grpc::StatusCode::CANCELLED, "client gone");
+  return grpc::Status::OK;
+}
+
+void JobManager::WorkerLoop() {
+  for (;;) {
+    std::shared_ptr<LiveJob> live;
+    {
+      std::unique_lock lock(mutex_);
+      changed_.wait(lock, [this] { return draining_ || !queue_.empty(); });
+      if (draining_) return;
+      live = live_.at(queue_.front());
+      queue_.pop_front();
+      uint32_t& queued = queued_by_owner_[live->row.owner];
+      if (queued > 0) --queued;
+      live->running = true;
+      live->started = SteadyClock::now();
+    }
+    RunJob(live);
+  }
+}
+
+void JobManager::RunJob(const std::shared_ptr<LiveJob>& live) {
+  const std::string& id = live->row.id;
+  const double started_unix_s = UnixNow();
+  const uint32_t attempts = store_->MarkRunning(id, started_unix_s);
+  {
+    std::lock_guard lock(mutex_);
+    live->row.state = v1::RUNNING;
+    live->row.started_unix_s = started_unix_s;
+    live->row.attempts = attempts;
+    ++live->version;
+    changed_.notify_all();
+  }
+  spdlog::info("job={} owner={} state=RUNNING runs={} attempt={} threads={}", id, live->row.owner,
+               live->row.runs_total, attempts, threads_per_job_);
+
+  v1::JobState final_state = v1::FAILED;
+  std::string error;
+  MonteCarloOutput output;
+  bool requeue = false;
+  try {
+    v1::SubmitJobRequest request;
+    if (!request.ParseFromString(live->row.request)) {
+      throw std::runtime_error("the stored request cannot be parsed");
+    }
+    const ValidatedJob job = ValidateSubmitRequest(request, threads_per_job_);
+    // As `driftlab run`: the Monte-Carlo with the job's analyses (covariance, filter consistency).
+    output = RunMonteCarloWithAnalysis(
+        job.spec,
+        [this, &live](const MonteCarloProgress& p) {
+          std::lock_guard lock(mutex_);
+          live->progress = p;
+          ++live->version;
+          changed_.notify_all();
+        },
+        &live->cancel);
+    if (output.statistics.cancelled()) {
+      std::lock_guard lock(mutex_);
+      final_state = v1::CANCELLED;
+      requeue = live->reason == CancelReason::kShutdown;
+      error =
+          live->reason == CancelReason::kDeadline ? "deadline exceeded" : "cancelled by its owner";
+    } else {
+      const v1::JobResult result =
+          jobspec::ToJobResult(jobspec::JobAsRun(request.job(), job.spec), output, version_);
+      store_->StoreResult(id, SerializeDeterministic(result), UnixNow());
+      final_state = v1::SUCCEEDED;
+    }
+  } catch (const SpecError& e) {
+    error = e.what();
+  } catch (const std::exception& e) {
+    error = std::string("internal error: ") + e.what();
+  }
+  if (requeue) {
+    store_->Requeue(id);
+  } else if (final_state != v1::SUCCEEDED) {
+    store_->MarkFinished(id, final_state, error, UnixNow());
+  }
+  const double seconds = std::chrono::duration<double>(SteadyClock::now() - live->started).count();
+  std::lock_guard lock(mutex_);
+  samples_finished_ += static_cast<uint64_t>(live->progress.samples_done);
+  live_.erase(id);
+  changed_.notify_all();
+  if (requeue) {
+    spdlog::info("job={} owner={} state=QUEUED runs={} seconds={:.3f} (stopped by shutdown)", id,
+                 live->row.owner, live->row.runs_total, seconds);
+  } else if (final_state == v1::SUCCEEDED) {
+    spdlog::info("job={} owner={} state=SUCCEEDED runs={} seconds={:.3f}", id, live->row.owner,
+                 live->row.runs_total, seconds);
+  } else {
+    spdlog::info("job={} owner={} state={} runs={} seconds={:.3f} error=\"{}\"", id,
+                 live->row.owner, v1::JobState_Name(final_state), live->row.runs_total, seconds,
+                 error);
+  }
+}
+
+void JobManager::DeadlineLoop() {
+  std::unique_lock lock(mutex_);
+  while (!stopped_) {
+    const double now = UnixNow();
+    double next = std::numeric_limits<double>::infinity();
+    std::vector<std::shared_ptr<LiveJob>> expired;
+    for (const auto& [id, live] : live_) {
+      if (!live->row.deadline_unix_s || live->reason != CancelReason::kNone) continue;
+      if (*live->row.deadline_unix_s <= now) {
+        expired.push_back(live);
+      } else {
+        next = std::min(next, *live->row.deadline_unix_s);
+      }
+    }
+    for (const std::shared_ptr<LiveJob>& live : expired) {
+      if (live->running) {
+        live->reason = CancelReason::kDeadline;
+        live->cancel.store(true);
+      } else if (!draining_) {
+        CancelQueuedLocked(live, "deadline exceeded");
+      }
+    }
+    // Sleep until the next deadline or a change (a new job, shutdown), at most 1 s.
+    const double wait_s = std::clamp(next - now, 0.001, 1.0);
+    changed_.wait_for(lock, std::chrono::duration<double>(wait_s));
+  }
+}
+
+}  // namespace driftlab::server

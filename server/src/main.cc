@@ -1,0 +1,125 @@
+// driftlab-server: the gRPC service of driftlab (DESIGN.md "Service").
+//
+//   driftlab-server --listen ADDR --data DIR [--tls-cert F --tls-key F] [--tokens FILE]
+//       [--max-concurrent-jobs N] [--max-queued-jobs N] [--max-job-samples N]
+//       [--threads-per-job N] [--examples DIR] [--port-file F] [--shutdown-grace-s S]
+//   driftlab-server hash-token TOKEN      prints the SHA-256 to put in a tokens file
+//
+// The first line on stdout is "listening on HOST:PORT" (with the bound port when ADDR ends in
+// :0); --port-file also writes the port (atomically: written to F.tmp, then renamed). Logs go to
+// stderr, one line per job transition. SIGTERM / SIGINT: graceful shutdown (server.h).
+#include <fmt/format.h>
+#include <spdlog/sinks/stdout_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <string>
+
+#include "driftlab/server/auth.h"
+#include "driftlab/server/server.h"
+#include "driftlab/spec_error.h"
+
+namespace {
+
+// Host part of "host:port" with the bound port.
+std::string BoundAddress(const std::string& listen, int port) {
+  const size_t colon = listen.rfind(':');
+  return (colon == std::string::npos ? listen : listen.substr(0, colon)) + ":" +
+         std::to_string(port);
+}
+
+void WritePortFile(const std::filesystem::path& path, int port) {
+  const std::filesystem::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << port << "\n";
+    if (!out) throw driftlab::SpecError("--port-file", path.string(), "a writable file");
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("driftlab-server: Monte-Carlo INS error analysis as a gRPC service");
+  app.set_version_flag("--version", std::string("driftlab-server ") + DRIFTLAB_VERSION);
+  driftlab::server::ServerOptions options;
+  std::string data_dir, examples_dir;
+  std::optional<std::string> tls_cert, tls_key, tokens, port_file;
+  double grace_s = 10.0;
+  app.add_option("--listen", options.listen, "Address to listen on, host:port (port 0 = any)")
+      ->capture_default_str();
+  app.add_option("--data", data_dir, "Data directory (SQLite store driftlab.db)");
+  app.add_option("--tls-cert", tls_cert, "Server certificate chain (PEM)");
+  app.add_option("--tls-key", tls_key, "Server private key (PEM)");
+  app.add_option("--tokens", tokens, "Tokens file: lines `OWNER SHA256HEX` (see hash-token)");
+  app.add_option("--max-concurrent-jobs", options.limits.max_concurrent_jobs,
+                 "Jobs running at once")
+      ->check(CLI::Range(1u, 1024u))
+      ->capture_default_str();
+  app.add_option("--max-queued-jobs", options.limits.max_queued_jobs, "Queued jobs per owner")
+      ->check(CLI::Range(1u, 1000000u))
+      ->capture_default_str();
+  app.add_option("--max-job-samples", options.limits.max_job_samples,
+                 "Largest job: runs x IMU samples per run")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  app.add_option("--threads-per-job", options.limits.threads_per_job,
+                 "Threads of one job (0 = hardware threads / max-concurrent-jobs)")
+      ->check(CLI::Range(0, 1024))
+      ->capture_default_str();
+  app.add_option("--max-message-bytes", options.limits.max_message_bytes, "Largest request message")
+      ->check(CLI::Range(1024, 1 << 30))
+      ->capture_default_str();
+  app.add_option("--examples", examples_dir, "Directory of example jobs (Catalog.ListExamples)");
+  app.add_option("--port-file", port_file, "Write the bound port to this file");
+  app.add_option("--shutdown-grace-s", grace_s,
+                 "On SIGTERM, running jobs may finish for this long before they are requeued")
+      ->check(CLI::Range(0.0, 86400.0))
+      ->capture_default_str();
+  std::string token;
+  CLI::App* hash = app.add_subcommand("hash-token", "Print the SHA-256 of TOKEN for a tokens file");
+  hash->add_option("token", token, "The bearer token")->required();
+  CLI11_PARSE(app, argc, argv);
+
+  if (hash->parsed()) {
+    fmt::print("{}\n", driftlab::server::Sha256Hex(token));
+    return 0;
+  }
+  if (data_dir.empty()) {
+    fmt::print(stderr, "error: --data DIR is required\n");
+    return 2;
+  }
+
+  driftlab::server::BlockShutdownSignals();  // before any thread exists
+
+  auto logger = spdlog::stderr_logger_mt("driftlab-server");
+  logger->set_pattern("%Y-%m-%dT%H:%M:%S.%e %l %v");
+  logger->flush_on(spdlog::level::info);
+  spdlog::set_default_logger(logger);
+
+  options.data_dir = data_dir;
+  options.examples_dir = examples_dir;
+  if (tls_cert) options.tls_cert = *tls_cert;
+  if (tls_key) options.tls_key = *tls_key;
+  if (tokens) options.tokens_file = *tokens;
+  options.shutdown_grace = std::chrono::milliseconds(static_cast<int64_t>(grace_s * 1000));
+
+  std::unique_ptr<driftlab::server::Server> server;
+  try {
+    server = std::make_unique<driftlab::server::Server>(options);
+    fmt::print("listening on {}\n", BoundAddress(options.listen, server->port()));
+    std::fflush(stdout);
+    if (port_file) WritePortFile(*port_file, server->port());
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 2;
+  }
+  spdlog::info("{} received", driftlab::server::WaitForShutdownSignal());
+  server->Shutdown();
+  return 0;
+}

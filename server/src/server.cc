@@ -1,0 +1,127 @@
+#include "driftlab/server/server.h"
+
+#include <grpcpp/ext/proto_server_reflection_plugin.h>
+#include <grpcpp/health_check_service_interface.h>
+#include <signal.h>
+#include <spdlog/spdlog.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "driftlab/server/data_services.h"
+#include "driftlab/server/jobs_service.h"
+#include "driftlab/spec_error.h"
+
+namespace driftlab::server {
+namespace {
+
+std::string ReadPem(const std::filesystem::path& path, const std::string& option) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in || text.str().empty()) throw SpecError(option, path.string(), "a readable PEM file");
+  return text.str();
+}
+
+}  // namespace
+
+namespace {
+
+sigset_t ShutdownSignals() {
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGTERM);
+  sigaddset(&signals, SIGINT);
+  return signals;
+}
+
+}  // namespace
+
+void BlockShutdownSignals() {
+  const sigset_t signals = ShutdownSignals();
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+}
+
+std::string WaitForShutdownSignal() {
+  const sigset_t signals = ShutdownSignals();
+  int signal_number = 0;
+  sigwait(&signals, &signal_number);
+  return signal_number == SIGTERM ? "SIGTERM" : "SIGINT";
+}
+
+bool IsLoopbackAddress(const std::string& listen) {
+  return listen.rfind("127.", 0) == 0 || listen.rfind("[::1]", 0) == 0 ||
+         listen.rfind("localhost:", 0) == 0 || listen.rfind("unix:", 0) == 0;
+}
+
+Server::Server(const ServerOptions& options) : options_(options) {
+  if (options.tls_cert.has_value() != options.tls_key.has_value()) {
+    throw SpecError(options.tls_cert ? "--tls-key" : "--tls-cert", "",
+                    "--tls-cert and --tls-key together");
+  }
+  if (options.tokens_file) {
+    auth_ = TokenAuthenticator::FromFile(*options.tokens_file);
+    spdlog::info("authentication: {} token(s) from {}", auth_.size(),
+                 options.tokens_file->string());
+  } else {
+    spdlog::warn("no --tokens file: every call is accepted as owner \"{}\"", kAnonymousOwner);
+  }
+  store_ = std::make_unique<JobStore>(options.data_dir);
+  manager_ = std::make_unique<JobManager>(store_.get(), options.limits, DRIFTLAB_VERSION);
+
+  grpc::EnableDefaultHealthCheckService(true);
+  grpc::reflection::InitProtoReflectionServerBuilderPlugin();
+  grpc::ServerBuilder builder;
+  std::shared_ptr<grpc::ServerCredentials> credentials;
+  if (options.tls_cert) {
+    grpc::SslServerCredentialsOptions ssl;
+    ssl.pem_key_cert_pairs.push_back(
+        {ReadPem(*options.tls_key, "--tls-key"), ReadPem(*options.tls_cert, "--tls-cert")});
+    credentials = grpc::SslServerCredentials(ssl);
+  } else {
+    credentials = grpc::InsecureServerCredentials();
+    if (!IsLoopbackAddress(options.listen)) {
+      spdlog::warn("listening on {} without TLS: tokens and jobs travel in clear text",
+                   options.listen);
+    }
+  }
+  builder.AddListeningPort(options.listen, credentials, &port_);
+  builder.SetMaxReceiveMessageSize(options.limits.max_message_bytes);
+
+  services_.push_back(MakeJobsService(&auth_, manager_.get()));
+  services_.push_back(MakeCatalogService(&auth_, options.examples_dir));
+  services_.push_back(MakeCalibrationService(&auth_, options.limits));
+  services_.push_back(MakeDatasetsService(&auth_, options.limits));
+  for (const auto& service : services_) builder.RegisterService(service.get());
+
+  manager_->Start();
+  server_ = builder.BuildAndStart();
+  if (!server_ || port_ == 0) {
+    manager_->Shutdown(std::chrono::milliseconds(0));
+    throw SpecError("--listen", options.listen, "an address this host can listen on (host:port)");
+  }
+  spdlog::info("listening on {} (port {}, {}, {} worker(s) x {} thread(s), data {})",
+               options.listen, port_, options.tls_cert ? "TLS" : "insecure",
+               options.limits.max_concurrent_jobs, manager_->threads_per_job(),
+               options.data_dir.string());
+}
+
+Server::~Server() { Shutdown(); }
+
+void Server::Shutdown() {
+  if (shut_down_) return;
+  shut_down_ = true;
+  spdlog::info("shutting down: no new jobs; running jobs get {} ms",
+               options_.shutdown_grace.count());
+  if (server_ && server_->GetHealthCheckService()) {
+    server_->GetHealthCheckService()->SetServingStatus(false);
+  }
+  manager_->Shutdown(options_.shutdown_grace);
+  if (server_) {
+    server_->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));
+    server_->Wait();
+  }
+  spdlog::info("stopped");
+}
+
+}  // namespace driftlab::server
