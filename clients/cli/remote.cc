@@ -314,14 +314,7 @@ int RunRemoteJob(const RemoteOptions& options, const RemoteRunRequest& run) {
     }
     if (!status.ok()) return ReportRpcError(status, options);
   }
-  try {
-    PrintFinalSummary(result);
-    WriteOutputs(result, run.out, run.report);
-  } catch (const std::exception& e) {
-    fmt::print(stderr, "error: {}\n", e.what());
-    return kExitFailure;
-  }
-  return kExitOk;
+  return PrintAndWriteOutputs(result, run.out, run.report);
 }
 
 size_t RowsPerChunk(size_t columns) {

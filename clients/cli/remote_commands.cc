@@ -157,14 +157,7 @@ int RunResult(const ResultOptions& options) {
   v1::JobResult result;
   const grpc::Status rpc = client.stub->GetResult(&context, Ref(options.job_id), &result);
   if (!rpc.ok()) return ReportRpcError(rpc, options.remote);
-  try {
-    PrintFinalSummary(result);
-    WriteOutputs(result, options.out, options.report);
-  } catch (const std::exception& e) {
-    fmt::print(stderr, "error: {}\n", e.what());
-    return kExitFailure;
-  }
-  return kExitOk;
+  return PrintAndWriteOutputs(result, options.out, options.report);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -256,14 +249,7 @@ int RunScore(const ScoreOptions& options) {
   if (open) writer->WritesDone();
   const grpc::Status rpc = writer->Finish();
   if (!rpc.ok()) return ReportRpcError(rpc, options.remote);
-  try {
-    PrintFinalSummary(result);
-    WriteOutputs(result, options.out, options.report);
-  } catch (const std::exception& e) {
-    fmt::print(stderr, "error: {}\n", e.what());
-    return kExitFailure;
-  }
-  return kExitOk;
+  return PrintAndWriteOutputs(result, options.out, options.report);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -94,6 +94,18 @@ void WriteOutputs(const v1::JobResult& result, const std::string& out,
   }
 }
 
+int PrintAndWriteOutputs(const v1::JobResult& result, const std::string& out,
+                         const std::optional<std::string>& report) {
+  try {
+    PrintFinalSummary(result);
+    WriteOutputs(result, out, report);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return kExitFailure;
+  }
+  return kExitOk;
+}
+
 namespace {
 
 struct RunOptions {
@@ -159,16 +171,15 @@ int RunRun(const RunOptions& options) {
     return kExitCancelled;
   }
   const double cpu_s = ProcessCpuSeconds() - cpu0_s;
+  v1::JobResult result;
   try {
-    const v1::JobResult result =
+    result =
         jobspec::ToJobResult(jobspec::JobAsRun(file.job, spec), output, DRIFTLAB_VERSION, cpu_s);
-    PrintFinalSummary(result);
-    WriteOutputs(result, options.out, options.report);
   } catch (const std::exception& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitFailure;
   }
-  return kExitOk;
+  return PrintAndWriteOutputs(result, options.out, options.report);
 }
 
 struct MergeOptions {
@@ -187,14 +198,7 @@ int RunMerge(const MergeOptions& options) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;
   }
-  try {
-    PrintFinalSummary(result);
-    WriteOutputs(result, options.out, options.report);
-  } catch (const std::exception& e) {
-    fmt::print(stderr, "error: {}\n", e.what());
-    return kExitFailure;
-  }
-  return kExitOk;
+  return PrintAndWriteOutputs(result, options.out, options.report);
 }
 
 const RegisterCommand kRun("run", [](CLI::App& app) -> std::function<int()> {

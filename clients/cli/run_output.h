@@ -19,4 +19,9 @@ void PrintFinalSummary(const v1::JobResult& result);
 void WriteOutputs(const v1::JobResult& result, const std::string& out,
                   const std::optional<std::string>& report);
 
+// PrintFinalSummary and WriteOutputs; returns the exit status (kExitOk, or kExitFailure with the
+// error on stderr).
+int PrintAndWriteOutputs(const v1::JobResult& result, const std::string& out,
+                         const std::optional<std::string>& report);
+
 }  // namespace driftlab::cli
