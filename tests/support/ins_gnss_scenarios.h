@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "bonferroni_checks.h"
 #include "driftlab/allan.h"
 #include "driftlab/attitude.h"
 #include "driftlab/error_state.h"
@@ -140,18 +141,6 @@ inline std::vector<Epoch> RunFilter(const Trajectory& t, const ImuErrorModel& mo
 // false-alarm probability is <= 5 % whatever the correlation between epochs (Bonferroni needs no
 // independence).
 inline constexpr int kChecksPerQuantity = 5;
-inline constexpr double kFamilyAlpha = 0.05;
-
-// m indices into a list of n candidates, evenly spaced and ending at the last: ceil(j n / m) - 1
-// for j = 1..m (fixed by rule before looking at any result).
-inline std::vector<size_t> EvenlySpacedPicks(size_t n, int m) {
-  std::vector<size_t> picks;
-  for (int j = 1; j <= m; ++j) {
-    picks.push_back(static_cast<size_t>(std::ceil(static_cast<double>(j) * n / m)) - 1);
-  }
-  return picks;
-}
-
 // Two-sided level-alpha bounds of the mean of n independent chi2(dof) variables: n x mean ~
 // chi2(dof n), bounds [chi2_{alpha/2}(dof n), chi2_{1 - alpha/2}(dof n)] / n (quantiles by
 // ChiSquareQuantile, allan.h).
