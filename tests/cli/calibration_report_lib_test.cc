@@ -13,21 +13,12 @@
 #include <string>
 #include <vector>
 
+#include "../support/cli_runner.h"
 #include "driftlab/calib/tumble.h"
 #include "driftlab/jobspec/calibration_job.h"
 #include "driftlab/jobspec/calibration_report.h"
 #include "driftlab/presets.h"
 #include "driftlab/spec_error.h"
-
-namespace driftlab::testing {
-// The driftlab binary: <build>/driftlab, this test being <build>/tests/cli/<name>.
-std::string DriftlabBinary() {
-  return (std::filesystem::canonical("/proc/self/exe").parent_path() / ".." / ".." / "driftlab")
-      .string();
-}
-}  // namespace driftlab::testing
-#define DRIFTLAB_CLI ::driftlab::testing::DriftlabBinary()
-#include "../support/cli_runner.h"
 
 namespace driftlab::jobspec {
 namespace {
@@ -183,8 +174,7 @@ TEST(CalibrationReport, CliWritesWhatRunCalibrationReturns) {
   }
   const fs::path json_path = scratch.dir() / "calib.json";
   const fs::path report_path = scratch.dir() / "calib.html";
-  ASSERT_TRUE(fs::exists(::driftlab::testing::DriftlabBinary()))
-      << "build the driftlab target first: " << ::driftlab::testing::DriftlabBinary();
+  ASSERT_TRUE(fs::exists(DRIFTLAB_CLI)) << "build the driftlab target first: " << DRIFTLAB_CLI;
   const auto r = RunDriftlab({"calibrate", "imu", csv.string(), "--lat", "45", "--out",
                               json_path.string(), "--report", report_path.string()},
                              scratch);

@@ -22,7 +22,7 @@ class CatalogServiceTest : public ::testing::Test {
  protected:
   TestAuthenticator accept_{true};
   std::unique_ptr<v1::Catalog::Service> service_ =
-      server::MakeCatalogService(&accept_, DRIFTLAB_SOURCE_DIR "/examples");
+      server::MakeCatalogService(&accept_, std::string(DRIFTLAB_SOURCE_DIR) + "/examples");
   InProcessServer server_{{service_.get()}};
   std::unique_ptr<v1::Catalog::Stub> stub_ = v1::Catalog::NewStub(server_.channel());
 };
@@ -125,7 +125,8 @@ TEST_F(CatalogServiceTest, ListExamplesOffersRunnableJobsWithoutFileReferences) 
 
 TEST(CatalogServiceAuth, CallWithoutValidTokenIsUnauthenticated) {
   TestAuthenticator reject(false);
-  auto service = server::MakeCatalogService(&reject, DRIFTLAB_SOURCE_DIR "/examples");
+  auto service =
+      server::MakeCatalogService(&reject, std::string(DRIFTLAB_SOURCE_DIR) + "/examples");
   InProcessServer server({service.get()});
   auto stub = v1::Catalog::NewStub(server.channel());
   grpc::ClientContext context;

@@ -299,12 +299,15 @@ TEST_F(DatasetsRoundTrip, ScoreOfExportedNavigationReproducesMonteCarloRunWithIn
 
 TEST_F(DatasetsRoundTrip, ScoreReproducesStaticAlignmentRunOfTheExample) {
   // One hour at rest at 20 Hz; each run aligns over 5 min (levelling, gyrocompassing).
-  Check(jobspec::LoadJobFile(DRIFTLAB_SOURCE_DIR "/examples/static_alignment_navigation.yaml").job,
+  Check(jobspec::LoadJobFile(std::string(DRIFTLAB_SOURCE_DIR) +
+                             "/examples/static_alignment_navigation.yaml")
+            .job,
         1, 7);
 }
 
 TEST_F(DatasetsRoundTrip, ScoreReproducesSeed000MechanizationRun) {
-  v1::Job job = jobspec::LoadJobFile(DRIFTLAB_SOURCE_DIR "/examples/ship_seaway.json").job;
+  v1::Job job =
+      jobspec::LoadJobFile(std::string(DRIFTLAB_SOURCE_DIR) + "/examples/ship_seaway.json").job;
   job.mutable_sensor()->set_preset("seed000-fog-imu");
   job.mutable_monte_carlo()->set_runs(3);
   Check(job, 5, 1);

@@ -1,6 +1,6 @@
 // Running the `driftlab` binary as a child process from tests: a scratch directory per test and
 // RunDriftlab(args) capturing exit status, stdout and stderr. Header-only; used by every
-// tests/cli/*cli_test.cc (they define DRIFTLAB_CLI, the binary's path).
+// tests/cli/*cli_test.cc (DRIFTLAB_CLI, the binary's path, comes from test_paths.h).
 #pragma once
 
 #include <fcntl.h>

@@ -11,8 +11,8 @@
 // The server is started with `--listen 127.0.0.1:0 --port-file F`; the constructor polls F (the
 // server writes it atomically once its port is bound) every 5 ms up to a deadline, and gives up
 // early when the child exits. No sleep is used as synchronisation. Header-only; the including
-// target defines DRIFTLAB_SERVER_BINARY (the server's path) and, for cli_runner.h, DRIFTLAB_CLI
-// (tests/server/CMakeLists.txt defines both).
+// test gets DRIFTLAB_SERVER_BINARY (the server's path) and DRIFTLAB_CLI from test_paths.h
+// (force-included into every test source).
 #pragma once
 
 #include <fcntl.h>
