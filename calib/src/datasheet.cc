@@ -8,7 +8,10 @@
 #include <set>
 #include <sstream>
 
+#include <yaml-cpp/yaml.h>
+
 #include "driftlab/sensors.h"
+#include "driftlab/input_files.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::calib {
@@ -25,110 +28,44 @@ std::string_view Trim(std::string_view s) {
   return s;
 }
 
+// The line of a YAML node, 1-based, for messages.
+int LineOf(const YAML::Node& node) { return node.Mark().line + 1; }
+
 std::string Where(std::string_view source, int line) {
   return std::string(source) + ":" + std::to_string(line);
 }
 
-// Removes a '#' comment that is not inside quotes (YAML: '#' starts a comment at the line start or
-// after whitespace).
-std::string_view StripComment(std::string_view line) {
-  char quote = 0;
-  for (size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quote != 0) {
-      if (c == '\\' && quote == '"') {
-        ++i;
-      } else if (c == quote) {
-        quote = 0;
-      }
-    } else if (c == '"' || c == '\'') {
-      quote = c;
-    } else if (c == '#' && (i == 0 || line[i - 1] == ' ' || line[i - 1] == '\t')) {
-      return line.substr(0, i);
-    }
+// Only plain values: no application tags (YAML's own, the quoted-scalar "!" and none are fine).
+void CheckTag(const YAML::Node& node, std::string_view source) {
+  const std::string& tag = node.Tag();
+  if (!tag.empty() && tag != "?" && tag != "!" && !tag.starts_with("tag:yaml.org,2002:")) {
+    throw SpecError(Where(source, LineOf(node)), "the tag '" + tag + "'", "plain YAML values");
   }
-  return line;
 }
 
-// A scalar: "double quoted" (escapes \" \\), 'single quoted' ('' = '), or plain.
-std::string Scalar(std::string_view s, const std::string& where) {
-  s = Trim(s);
-  if (s.empty()) return "";
-  if (s.front() == '"' || s.front() == '\'') {
-    const char q = s.front();
-    std::string out;
-    size_t i = 1;
-    for (; i < s.size(); ++i) {
-      if (q == '"' && s[i] == '\\' && i + 1 < s.size()) {
-        out += s[++i];
-      } else if (q == '\'' && s[i] == '\'' && i + 1 < s.size() && s[i + 1] == '\'') {
-        out += '\'';
-        ++i;
-      } else if (s[i] == q) {
-        break;
-      } else {
-        out += s[i];
-      }
-    }
-    if (i >= s.size() || !Trim(s.substr(i + 1)).empty()) {
-      throw SpecError(where, "'" + std::string(s) + "'",
-                      "a scalar in matching quotes with nothing after the closing quote");
-    }
-    return out;
+// A scalar value of `key`: its text as written (quotes removed by YAML). `text` is the document.
+std::string ScalarText(const YAML::Node& node, const std::string& key, std::string_view text,
+                       std::string_view source) {
+  CheckTag(node, source);
+  if (node.IsNull()) return "";
+  if (!node.IsScalar()) {
+    throw SpecError(Where(source, LineOf(node)) + ": " + key, "a list or mapping",
+                    "one value (a figure as printed, e.g. \"0.15 deg/√h\")");
   }
-  return std::string(s);
+  if (node.Tag() == "!" && node.Mark().pos >= 0 &&
+      !YamlQuotedScalarIsClosed(text, static_cast<size_t>(node.Mark().pos))) {
+    throw SpecError(Where(source, LineOf(node)) + ": " + key, "a quote that is never closed",
+                    "a closed 'single' or \"double\" quoted value");
+  }
+  return node.Scalar();
 }
 
-// Splits "key: value" at the first ':' followed by a space or the end (outside quotes).
-bool SplitKey(std::string_view line, std::string_view* key, std::string_view* value) {
-  char quote = 0;
-  for (size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quote != 0) {
-      if (c == quote) quote = 0;
-    } else if (c == '"' || c == '\'') {
-      quote = c;
-    } else if (c == ':' && (i + 1 == line.size() || line[i + 1] == ' ' || line[i + 1] == '\t')) {
-      *key = Trim(line.substr(0, i));
-      *value = Trim(line.substr(i + 1));
-      return !key->empty();
-    }
+std::string KeyText(const YAML::Node& key, std::string_view source) {
+  CheckTag(key, source);
+  if (!key.IsScalar()) {
+    throw SpecError(Where(source, LineOf(key)), "a key that is not a name", "key: value");
   }
-  return false;
-}
-
-// Entries of a one-line flow mapping "{a: x, b: "y, z"}".
-void ParseFlowMapping(std::string_view text, const std::string& section, int line,
-                      std::string_view source, std::vector<DatasheetEntry>* out) {
-  const std::string where = Where(source, line);
-  if (text.size() < 2 || text.back() != '}') {
-    throw SpecError(where, "'" + std::string(text) + "'",
-                    "a flow mapping {key: value, ...} on one line");
-  }
-  std::string_view body = text.substr(1, text.size() - 2);
-  char quote = 0;
-  size_t start = 0;
-  for (size_t i = 0; i <= body.size(); ++i) {
-    const char c = i < body.size() ? body[i] : ',';
-    if (quote != 0) {
-      if (c == quote) quote = 0;
-      continue;
-    }
-    if (c == '"' || c == '\'') {
-      quote = c;
-      continue;
-    }
-    if (c != ',') continue;
-    const std::string_view item = Trim(body.substr(start, i - start));
-    start = i + 1;
-    if (item.empty()) continue;
-    std::string_view key, value;
-    if (!SplitKey(item, &key, &value)) {
-      throw SpecError(where, "'" + std::string(item) + "'", "key: value");
-    }
-    out->push_back({section + "." + Scalar(key, where), Scalar(value, where), line});
-  }
-  if (quote != 0) throw SpecError(where, "'" + std::string(text) + "'", "closed quotes");
+  return key.Scalar();
 }
 
 // What one key means.
@@ -202,63 +139,65 @@ std::string SiUnitText(Dimension d) {
   return DimensionName(d);
 }
 
+// Any valid YAML (block or flow style, comments, multi-line flow mappings) read with yaml-cpp;
+// the structure is fixed (a mapping of name, description, gyro, accel; gyro and accel mappings of
+// scalars), so nothing is walked beyond two levels and aliases cannot expand it.
 std::vector<DatasheetEntry> ParseDatasheetText(std::string_view text, std::string_view source) {
+  std::vector<YAML::Node> documents;
+  try {
+    documents = YAML::LoadAll(std::string(text));
+  } catch (const YAML::Exception& e) {
+    throw SpecError(Where(source, e.mark.line + 1),
+                    "invalid YAML (" + e.msg + ")", "a YAML mapping of name, description, gyro, "
+                    "accel");
+  }
+  if (documents.size() != 1 || !documents.front().IsMap() || documents.front().size() == 0) {
+    const bool empty =
+        documents.empty() || (documents.size() == 1 && documents.front().IsNull());
+    throw SpecError(std::string(source),
+                    empty                   ? std::string("an empty datasheet")
+                    : documents.size() > 1 ? std::to_string(documents.size()) + " YAML documents"
+                                           : std::string("not a mapping of keys"),
+                    "one YAML document: a mapping of name, description, gyro, accel with at "
+                    "least one figure");
+  }
+  const YAML::Node& root = documents.front();
+  CheckTag(root, source);
   std::vector<DatasheetEntry> entries;
   std::set<std::string> seen;
-  std::string section;  // "gyro" / "accel" while inside a block mapping
-  int line_no = 0;
-  size_t pos = 0;
-  if (text.starts_with("\xEF\xBB\xBF")) pos = 3;  // UTF-8 byte-order mark
   auto add = [&](DatasheetEntry e) {
     if (!seen.insert(e.key).second) {
       throw SpecError(Where(source, e.line) + ": " + e.key, "a second value", "each key once");
     }
     entries.push_back(std::move(e));
   };
-  while (pos <= text.size()) {
-    size_t end = text.find('\n', pos);
-    if (end == std::string_view::npos) end = text.size();
-    const std::string_view raw = text.substr(pos, end - pos);
-    pos = end + 1;
-    ++line_no;
-    const std::string_view content = StripComment(raw);
-    if (Trim(content).empty() || Trim(content) == "---") continue;
-    const std::string where = Where(source, line_no);
-    if (content.find('\t') != std::string_view::npos &&
-        content.find_first_not_of(" \t") > content.find('\t')) {
-      throw SpecError(where, "a tab in the indentation", "spaces (YAML)");
-    }
-    const bool indented = content.front() == ' ';
-    std::string_view key, value;
-    if (!SplitKey(Trim(content), &key, &value)) {
-      throw SpecError(where, "'" + std::string(Trim(raw)) + "'", "key: value (YAML mapping)");
-    }
-    const std::string k = Scalar(key, where);
-    if (indented) {
-      if (section.empty()) {
-        throw SpecError(where, "'" + std::string(Trim(raw)) + "' (indented)",
-                        "indented keys only under gyro: or accel:");
-      }
-      add({section + "." + k, Scalar(value, where), line_no});
-      continue;
-    }
-    section.clear();
+  size_t figures = 0;
+  for (const auto& item : root) {
+    const std::string k = KeyText(item.first, source);
+    const int line = LineOf(item.first);
     if (k == "name" || k == "description") {
-      add({k, Scalar(value, where), line_no});
+      add({k, ScalarText(item.second, k, text, source), line});
     } else if (k == "gyro" || k == "accel") {
-      if (!seen.insert(k).second)
-        throw SpecError(where + ": " + k, "a second section", "each once");
-      if (value.empty()) {
-        section = k;
-      } else if (value.front() == '{') {
-        ParseFlowMapping(value, k, line_no, source, &entries);
-      } else {
-        throw SpecError(where + ": " + k, "'" + std::string(value) + "'",
+      if (!seen.insert(k).second) {
+        throw SpecError(Where(source, line) + ": " + k, "a second section", "each once");
+      }
+      CheckTag(item.second, source);
+      if (!item.second.IsMap()) {
+        throw SpecError(Where(source, line) + ": " + k, "not a mapping",
                         "a mapping (indented lines below, or {key: value, ...})");
       }
+      for (const auto& figure : item.second) {
+        const std::string key = k + "." + KeyText(figure.first, source);
+        add({key, ScalarText(figure.second, key, text, source), LineOf(figure.first)});
+        ++figures;
+      }
     } else {
-      throw SpecError(where + ": " + k, "unknown key", "name, description, gyro, accel");
+      throw SpecError(Where(source, line) + ": " + k, "unknown key",
+                      "name, description, gyro, accel");
     }
+  }
+  if (figures == 0) {
+    throw SpecError(std::string(source), "no figures", "at least one figure under gyro or accel");
   }
   return entries;
 }
@@ -364,11 +303,8 @@ DatasheetModel DatasheetToModel(const std::vector<DatasheetEntry>& entries) {
 }
 
 DatasheetModel LoadDatasheet(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw SpecError("DATASHEET", path.string(), "an existing, readable YAML file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return DatasheetToModel(ParseDatasheetText(text.str(), path.string()));
+  const std::string text = ReadInputFile(path, kMaxSmallTextFileBytes, "DATASHEET");
+  return DatasheetToModel(ParseDatasheetText(text, path.string()));
 }
 
 }  // namespace driftlab::calib

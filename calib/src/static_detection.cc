@@ -9,6 +9,7 @@
 #include <limits>
 #include <string_view>
 
+#include "driftlab/input_files.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::calib {
@@ -74,15 +75,14 @@ RawImuRecording ReadRawImuCsv(const std::string& path, double rate_hz) {
   if (!(rate_hz >= 0.0) || !std::isfinite(rate_hz)) {
     throw SpecError("--rate", fmt::format("{}", rate_hz), "> 0 Hz, or 0 for a time column");
   }
-  std::ifstream in(path);
-  if (!in) throw SpecError(path, "cannot open the file", 0);
+  std::ifstream in = OpenInputFile(path, kMaxRecordingFileBytes, path);
   const size_t columns = rate_hz > 0.0 ? 6 : 7;
   RawImuRecording r;
   std::string line;
   std::vector<double> v;
   size_t line_no = 0;
   bool first_data_line = true;
-  while (std::getline(in, line)) {
+  while (ReadLine(in, &line, path + ":" + std::to_string(line_no + 1))) {
     ++line_no;
     if (line.empty() || line[0] == '#' || line.find_first_not_of(" \t\r") == std::string::npos) {
       continue;

@@ -11,6 +11,7 @@
 #include <string_view>
 #include <utility>
 
+#include "driftlab/input_files.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab {
@@ -64,7 +65,7 @@ class CsvReader {
   // Next non-blank line; false at the end.
   bool Next(Line* line) {
     std::string text;
-    while (std::getline(in_, text)) {
+    while (ReadLine(in_, &text, name_ + ":" + std::to_string(number_ + 1))) {
       ++number_;
       if (Trim(text).empty()) continue;
       line->number = number_;
@@ -114,13 +115,9 @@ class CsvReader {
   int number_ = 0;
 };
 
+// A motion or truth-profile file: a regular file of at most kMaxMotionFileBytes (input_files.h).
 std::ifstream OpenInput(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) {
-    throw SpecError(path.string(),
-                    std::string("cannot open the file (") + std::strerror(errno) + ")", 0);
-  }
-  return in;
+  return OpenInputFile(path, kMaxMotionFileBytes, path.string());
 }
 
 const char* const kInitialColumns[9] = {

@@ -144,11 +144,14 @@ class UnitParser {
   explicit UnitParser(std::string_view text) : text_(text) {}
 
   Term Parse() {
+    if (text_.size() > kMaxUnitTextBytes) {
+      Fail("longer than " + std::to_string(kMaxUnitTextBytes) + " bytes");
+    }
     SkipSpace();
     if (pos_ == text_.size()) return Term{};  // no unit: dimensionless
     Term t = Product();
     SkipSpace();
-    if (pos_ != text_.size()) Fail("unexpected '" + std::string(text_.substr(pos_)) + "'");
+    if (pos_ != text_.size()) Fail("unexpected '" + std::string(text_.substr(pos_, 20)) + "'");
     return t;
   }
 
@@ -259,7 +262,17 @@ class UnitParser {
     return {factor, {d.angle2 * p / q, d.length2 * p / q, d.time2 * p / q}};
   }
 
+  // Factor nests (parentheses, square roots): bounded so that no input exhausts the stack.
   Term Factor() {
+    if (++depth_ > kMaxUnitNesting) {
+      Fail("nested deeper than " + std::to_string(kMaxUnitNesting) + " levels");
+    }
+    Term t = FactorBody();
+    --depth_;
+    return t;
+  }
+
+  Term FactorBody() {
     SkipSpace();
     if (Consume("(")) {
       Term t = Product();
@@ -295,6 +308,7 @@ class UnitParser {
 
   std::string_view text_;
   size_t pos_ = 0;
+  int depth_ = 0;
 };
 
 std::string_view Trim(std::string_view s) {

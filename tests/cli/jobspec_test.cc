@@ -335,10 +335,10 @@ TEST(JobSpec, YamlScalarsResolveByTheCoreSchema) {
 TEST(JobSpec, SyntaxErrorsAreOneLineWithTheSource) {
   const std::string json_error = JsonError("{\"rate_hz\": 100,\n \"motion\" {}}");
   EXPECT_EQ(json_error.find('\n'), std::string::npos) << json_error;
-  // The missing ':' is on line 2 of the text.
-  EXPECT_TRUE(
-      json_error.starts_with("job: invalid JSON at line 2: Expected : between key:value "
-                             "pair. near `"))
+  // The missing ':' is on line 2 of the text, column 11 (CheckJsonSyntax, issue 15; the message
+  // was protobuf's before).
+  EXPECT_TRUE(json_error.starts_with(
+      "job: invalid JSON at line 2, column 11: expected ':' after a member name, found '{'"))
       << json_error;
   const std::string yaml_error = YamlError("motion:\n  initial: [1, 2\n");
   EXPECT_EQ(yaml_error.find('\n'), std::string::npos) << yaml_error;

@@ -21,6 +21,7 @@
 #include "driftlab/calib/reference_calibration.h"
 #include "driftlab/calib/static_detection.h"
 #include "driftlab/jobspec/sensor_model_json.h"
+#include "driftlab/input_files.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/units.h"
 #include "field_checks.h"
@@ -76,9 +77,7 @@ bool ParseNumber(std::string_view text, double* value) {
 // The reader behind both ReadNumericCsv overloads; `selected` empty = every column.
 NumericTable ReadCsv(const std::string& path, const std::vector<std::string>* selected,
                      const std::string& columns_field) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in)
-    throw SpecError("DATA", "'" + path + "'", "an existing, readable CSV file (open failed)");
+  std::ifstream in = OpenInputFile(path, kMaxRecordingFileBytes, "DATA");
   NumericTable table;
   std::string line;
   size_t line_no = 0;
@@ -87,7 +86,8 @@ NumericTable ReadCsv(const std::string& path, const std::vector<std::string>* se
   std::vector<size_t> take;  // header index of each kept column
   bool have_header = false;
   bool pending_data = false;  // the first line was data (no header)
-  while (std::getline(in, line)) {
+  const auto where = [&] { return fmt::format("{}:{}", path, line_no + 1); };
+  while (ReadLine(in, &line, where())) {
     ++line_no;
     const std::string_view t = Trim(line);
     if (t.empty() || t.front() == '#') continue;
@@ -105,6 +105,24 @@ NumericTable ReadCsv(const std::string& path, const std::vector<std::string>* se
     }
     have_header = true;
     break;
+  }
+  if (header.size() > kMaxCsvColumns) {
+    throw SpecError(fmt::format("{}:{}", path, line_no), fmt::format("{} columns", header.size()),
+                    fmt::format("at most {} columns", kMaxCsvColumns));
+  }
+  for (size_t i = 0; i < header.size(); ++i) {
+    if (header[i].size() > kMaxCsvColumnNameBytes) {
+      throw SpecError(fmt::format("{}:{}: column {}", path, line_no, i + 1),
+                      "'" + header[i] + "'",
+                      fmt::format("a column name of at most {} bytes", kMaxCsvColumnNameBytes));
+    }
+    for (size_t j = 0; j < i; ++j) {
+      if (header[i] == header[j]) {
+        throw SpecError(fmt::format("{}:{}: column {}", path, line_no, i + 1),
+                        "'" + header[i] + "' (also column " + std::to_string(j + 1) + ")",
+                        "distinct column names");
+      }
+    }
   }
   if (!have_header) {
     throw SpecError("DATA", "'" + path + "' (empty)", "a header row and numeric rows");
@@ -141,7 +159,7 @@ NumericTable ReadCsv(const std::string& path, const std::vector<std::string>* se
     }
   };
   if (pending_data) parse_row(line_no);
-  while (std::getline(in, line)) {
+  while (ReadLine(in, &line, where())) {
     ++line_no;
     const std::string_view t = Trim(line);
     if (t.empty() || t.front() == '#') continue;
@@ -175,24 +193,27 @@ void SetUnit(RateColumn* column, const std::string& text, const Unit& unit) {
 
 // Unit from the name's suffix: the longest tail of '_'-separated words that parses as a unit of
 // an accepted dimension ("per" = '/'). Returns false if no tail does.
+// Tails are built from the end, one word at a time, and no longer than a unit text may be
+// (kMaxUnitTextBytes), so the search is linear in the name's length.
 bool UnitFromName(RateColumn* column) {
   const std::vector<std::string> words = Split(column->name, '_');
-  for (size_t first = 1; first < words.size(); ++first) {
-    std::string text;
-    for (size_t i = first; i < words.size(); ++i) {
-      text += (text.empty() ? "" : " ") + (words[i] == "per" ? std::string("/") : words[i]);
-    }
+  std::string tail;
+  bool found = false;
+  for (size_t first = words.size(); first-- > 1;) {
+    const std::string word = words[first] == "per" ? std::string("/") : words[first];
+    tail = tail.empty() ? word : word + " " + tail;
+    if (tail.size() > kMaxUnitTextBytes) break;
     try {
-      const Unit unit = ParseUnit(text, column->name);
+      const Unit unit = ParseUnit(tail, column->name);
       if (AcceptedDimension(unit.dimension)) {
-        SetUnit(column, text, unit);
-        return true;
+        SetUnit(column, tail, unit);  // a longer tail found later replaces it
+        found = true;
       }
     } catch (const SpecError&) {
-      // Not a unit: try a shorter tail.
+      // Not a unit: try a longer tail.
     }
   }
-  return false;
+  return found;
 }
 
 // ---------------------------------------------------------------------------------------------

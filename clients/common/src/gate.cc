@@ -13,6 +13,7 @@
 #include <unordered_map>
 
 #include "driftlab/jobspec/result_file.h"
+#include "driftlab/input_files.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::jobspec {
@@ -292,15 +293,9 @@ std::vector<GateRule> ParseGateRules(std::string_view text, std::string_view sou
 
 std::vector<GateRule> LoadGateRules(const std::filesystem::path& path) {
   const std::string name = path.string();
-  std::error_code error;
-  std::ifstream in(path, std::ios::binary);
-  if (!std::filesystem::is_regular_file(path, error) || !in) {
-    throw SpecError(name, "cannot read the rules file", 0);
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
+  const std::string text = ReadInputFile(path, kMaxSmallTextFileBytes, name);
   try {
-    return ParseGateRules(text.str(), name);
+    return ParseGateRules(text, name);
   } catch (const SpecError& e) {
     if (e.field() == name) throw;
     throw SpecError(name, e.what(), 0);

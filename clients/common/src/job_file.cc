@@ -11,7 +11,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "driftlab/jobspec/json_syntax.h"
 #include "driftlab/jobspec/schema_check.h"
+#include "driftlab/input_files.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::jobspec {
@@ -120,7 +122,43 @@ void ResolvePlainScalar(const std::string& text, Value* out) {
   }
 }
 
-void YamlToValue(const YAML::Node& node, const std::string& path, Value* out) {
+// The conversion walks the YAML tree with aliases expanded; `budget` bounds the nodes it makes, so
+// an alias bomb (a few hundred bytes of anchors referring to anchors, expanding to billions of
+// nodes) is refused after kMaxYamlNodes, and `depth` bounds the nesting, which also stops a
+// self-referencing alias (&a [*a], a cycle) instead of recursing until the stack overflows.
+struct YamlWalk {
+  size_t nodes = 0;
+  std::string_view source;
+  std::string_view text;  // the document, to check that quoted scalars are closed
+};
+
+void YamlToValue(const YAML::Node& node, const std::string& path, Value* out, YamlWalk* walk,
+                 int depth) {
+  const std::string where = path.empty() ? std::string(walk->source) : path;
+  if (depth > kMaxYamlDepth) {
+    throw SpecError(where,
+                    fmt::format("nested deeper than {} levels (or an alias that refers to "
+                                "itself); allowed: at most {} levels",
+                                kMaxYamlDepth, kMaxYamlDepth),
+                    0);
+  }
+  if (++walk->nodes > kMaxYamlNodes) {
+    throw SpecError(std::string(walk->source),
+                    fmt::format("more than {} values once aliases are expanded; allowed: at most "
+                                "{} values",
+                                kMaxYamlNodes, kMaxYamlNodes),
+                    0);
+  }
+  // Tags: none ("?"), the quoted-scalar "!", and the core schema's own; anything else
+  // (application tags such as !!python/object or !custom) is refused rather than ignored.
+  const std::string& tag = node.Tag();
+  if (!tag.empty() && tag != "?" && tag != "!" && !tag.starts_with("tag:yaml.org,2002:")) {
+    throw SpecError(where,
+                    fmt::format("line {}: the tag '{}' is not allowed; allowed: plain YAML "
+                                "values (no tags)",
+                                node.Mark().line + 1, tag),
+                    0);
+  }
   switch (node.Type()) {
     case YAML::NodeType::Map: {
       auto* fields = out->mutable_struct_value()->mutable_fields();
@@ -138,7 +176,7 @@ void YamlToValue(const YAML::Node& node, const std::string& path, Value* out) {
               child,
               fmt::format("line {}: given twice; allowed: once", entry.first.Mark().line + 1), 0);
         }
-        YamlToValue(entry.second, child, &(*fields)[key]);
+        YamlToValue(entry.second, child, &(*fields)[key], walk, depth + 1);
       }
       return;
     }
@@ -146,12 +184,21 @@ void YamlToValue(const YAML::Node& node, const std::string& path, Value* out) {
       auto* values = out->mutable_list_value();
       int i = 0;
       for (const auto& element : node) {
-        YamlToValue(element, fmt::format("{}[{}]", path, i++), values->add_values());
+        YamlToValue(element, fmt::format("{}[{}]", path, i++), values->add_values(), walk,
+                    depth + 1);
       }
       return;
     }
     case YAML::NodeType::Scalar:
       // "!" is yaml-cpp's tag for quoted scalars; an explicit !!str also means string.
+      if (node.Tag() == "!" && node.Mark().pos >= 0 &&
+          !YamlQuotedScalarIsClosed(walk->text, static_cast<size_t>(node.Mark().pos))) {
+        throw SpecError(where,
+                        fmt::format("line {}: a quote that is never closed; allowed: a closed "
+                                    "'single' or \"double\" quoted value",
+                                    node.Mark().line + 1),
+                        0);
+      }
       if (node.Tag() == "!" || node.Tag() == "tag:yaml.org,2002:str") {
         out->set_string_value(node.Scalar());
       } else {
@@ -165,17 +212,24 @@ void YamlToValue(const YAML::Node& node, const std::string& path, Value* out) {
 }
 
 Value YamlTextToValue(std::string_view yaml_text, std::string_view source) {
-  YAML::Node root;
+  std::vector<YAML::Node> documents;
   try {
-    root = YAML::Load(std::string(yaml_text));
+    documents = YAML::LoadAll(std::string(yaml_text));
   } catch (const YAML::Exception& e) {
     throw SpecError(std::string(source),
                     fmt::format("invalid YAML at line {}, column {}: {}", e.mark.line + 1,
                                 e.mark.column + 1, e.msg),
                     0);
   }
+  if (documents.size() > 1) {
+    throw SpecError(std::string(source),
+                    fmt::format("{} YAML documents (separated by ---); allowed: one document",
+                                documents.size()),
+                    0);
+  }
   Value value;
-  YamlToValue(root, "", &value);
+  YamlWalk walk{0, source, yaml_text};
+  YamlToValue(documents.empty() ? YAML::Node() : documents.front(), "", &value, &walk, 0);
   return value;
 }
 
@@ -194,6 +248,7 @@ v1::Job ValueToJob(const Value& value, std::string_view source) {
 }  // namespace
 
 v1::Job ParseJobJson(std::string_view json_text, std::string_view source) {
+  CheckJsonSyntax(json_text, source);
   Value value;
   util::Status status = util::JsonStringToMessage(json_text, &value);
   if (!status.ok()) {
@@ -226,16 +281,9 @@ JobFile LoadJobFile(const std::filesystem::path& path) {
                                 extension),
                     0);
   }
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) {
-    throw SpecError(name, "cannot read the file (not found or not a regular file)", 0);
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw SpecError(name, fmt::format("cannot read the file ({})", std::strerror(errno)), 0);
-  std::ostringstream text;
-  text << in.rdbuf();
+  const std::string text = ReadInputFile(path, kMaxJobFileBytes, name);
   JobFile file;
-  file.job = is_json ? ParseJobJson(text.str(), name) : ParseJobYaml(text.str(), name);
+  file.job = is_json ? ParseJobJson(text, name) : ParseJobYaml(text, name);
   file.base_dir = std::filesystem::absolute(path).parent_path();
   return file;
 }

@@ -13,6 +13,8 @@
 #include <limits>
 #include <sstream>
 
+#include "driftlab/input_files.h"
+#include "driftlab/jobspec/json_syntax.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::jobspec {
@@ -281,6 +283,7 @@ std::string JobResultToJson(const v1::JobResult& result) {
 
 v1::JobResult ParseJobResultJson(std::string_view json_text, std::string_view source) {
   v1::JobResult result;
+  CheckJsonSyntax(json_text, source, "result JSON");
   const util::Status status = util::JsonStringToMessage(json_text, &result);
   if (!status.ok()) {
     throw SpecError(std::string(source), "invalid result JSON: " + OneLine(status), 0);
@@ -295,15 +298,8 @@ v1::JobResult ParseJobResultJson(std::string_view json_text, std::string_view so
 
 v1::JobResult ReadJobResult(const std::filesystem::path& path) {
   const std::string name = path.string();
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(path, error)) {
-    throw SpecError(name, "no such file (a result file written by `driftlab run`)", 0);
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw SpecError(name, fmt::format("cannot open: {}", std::strerror(errno)), 0);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return ParseJobResultJson(text.str(), name);
+  const std::string text = ReadInputFile(path, kMaxResultFileBytes, name);
+  return ParseJobResultJson(text, name);
 }
 
 void WriteJobResult(const std::filesystem::path& path, const v1::JobResult& result) {

@@ -24,10 +24,16 @@
 // 952-1997 and 1293-1998 for the inertial-sensor units.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <string_view>
 
 namespace driftlab {
+
+// Limits of a unit text (issue 15: hostile input is bounded before the work): its length and the
+// nesting of parentheses and square roots. Real units ("((deg/h)/sqrt(Hz))") use 2 or 3 levels.
+inline constexpr size_t kMaxUnitTextBytes = 128;
+inline constexpr int kMaxUnitNesting = 8;
 
 // Dimension as exponents, in halves, of plane angle, length and time.
 struct Dimension {

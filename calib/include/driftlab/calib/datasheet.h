@@ -3,7 +3,8 @@
 // module converts them through the units module (units.h) into an ImuErrorModel (SI,
 // sensor_params.h) with the mapping of presets.h, and lists every derived SI value.
 //
-// File format (a subset of YAML: block or one-line flow mappings of scalars, '#' comments):
+// File format: YAML (any form: block or flow mappings, multi-line flow mappings, comments, quotes),
+// one document, a mapping of name, description, gyro, accel; gyro and accel map keys to scalars:
 //
 //   name: stim300                       # optional, the model's name
 //   description: "STIM300 rev. 9 ..."   # optional
@@ -69,9 +70,10 @@ struct DatasheetEntry {
   int line = 0;
 };
 
-// Parses the YAML subset above. `source` names the text in messages ("file.yaml:12"). Throws
-// SpecError for a syntax error, a duplicate key or a top-level key other than name, description,
-// gyro, accel.
+// Parses the YAML above (yaml-cpp). `source` names the text in messages ("file.yaml:12"). Throws
+// SpecError for a syntax error, an empty text or one without figures, several documents, a tag, a
+// duplicate key, a list or mapping where a figure belongs, or a top-level key other than name,
+// description, gyro, accel.
 std::vector<DatasheetEntry> ParseDatasheetText(std::string_view text, std::string_view source);
 
 // Converts entries to the model and validates it (ValidateImuErrorModel). Throws SpecError.

@@ -22,9 +22,15 @@ struct NumericTable {
   size_t rows() const { return columns.empty() ? 0 : values.size() / columns.size(); }
 };
 
+// Limits of a CSV recording besides input_files.h's (file size, line length): columns, and the
+// length of a column name (the unit-suffix search is bounded by units.h's kMaxUnitTextBytes).
+inline constexpr size_t kMaxCsvColumns = 1000;
+inline constexpr size_t kMaxCsvColumnNameBytes = 256;
+
 // Reads a CSV file (one header row of names, then numeric rows; '#' lines and empty lines skipped).
 // Throws SpecError naming "FILE:LINE" for a non-numeric or non-finite field or a wrong column
-// count.
+// count, and for a header with repeated names or over the limits above; the file must be a regular
+// file within kMaxRecordingFileBytes (input_files.h).
 NumericTable ReadNumericCsv(const std::string& path);
 // (Addition, H4.) A file whose first non-comment line is all numbers has no header: that line is
 // data and the columns are named column1, column2, ... (`driftlab calibrate` reads positional

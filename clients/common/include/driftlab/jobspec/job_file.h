@@ -16,6 +16,14 @@
 
 namespace driftlab::jobspec {
 
+// Limits of a YAML document, checked while it is converted (issue 15): nesting depth, and the
+// number of values once aliases are expanded (an "alias bomb" of a few hundred bytes would
+// otherwise expand to billions). JSON input is checked by CheckJsonSyntax (json_syntax.h); a job
+// file is at most kMaxJobFileBytes (input_files.h). A YAML text holds one document; tags other
+// than YAML's own are refused.
+inline constexpr int kMaxYamlDepth = 64;
+inline constexpr size_t kMaxYamlNodes = 1000000;
+
 // A job as loaded from a file: relative file paths inside it resolve against base_dir.
 struct JobFile {
   v1::Job job;
