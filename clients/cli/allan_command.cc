@@ -277,15 +277,7 @@ int RunAllan(const AllanCliOptions& options) {
     fmt::print(stderr, "error: JSON output failed: {}\n", status.ToString());
     return kExitFailure;
   }
-  std::ofstream out(options.out_path, std::ios::binary | std::ios::trunc);
-  out << json;
-  out.close();
-  if (!out) {
-    fmt::print(stderr, "error: --out: cannot write '{}'\n", options.out_path);
-    return kExitFailure;
-  }
-  fmt::print("wrote {}\n", options.out_path);
-  return kExitOk;
+  return WriteOutputText(options.out_path, json, "--out");
 }
 
 const RegisterCommand kAllan("allan", [](CLI::App& app) -> std::function<int()> {

@@ -33,18 +33,6 @@ std::vector<std::string> SplitNames(const std::string& text) {
   return out;
 }
 
-bool WriteText(const std::string& path, const std::string& text, const char* option) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
-  out.close();
-  if (!out) {
-    fmt::print(stderr, "error: {}: cannot write '{}'\n", option, path);
-    return false;
-  }
-  fmt::print("wrote {}\n", path);
-  return true;
-}
-
 }  // namespace
 
 int RunAllanFit(const AllanFitOptions& options) {
@@ -102,14 +90,11 @@ int RunAllanFit(const AllanFitOptions& options) {
       fmt::print(stderr, "error: cannot convert the model to JSON\n");
       return kExitFailure;
     }
-    if (!WriteText(options.out_path, json, "--out")) return kExitFailure;
+    if (const int status = WriteOutputText(options.out_path, json, "--out")) return status;
   }
-  if (!options.report_path.empty() &&
-      !WriteText(options.report_path, jobspec::RenderNoiseFitReport(fit, options.data_path),
-                 "--report")) {
-    return kExitFailure;
-  }
-  return kExitOk;
+  if (options.report_path.empty()) return kExitOk;
+  return WriteOutputText(options.report_path,
+                         jobspec::RenderNoiseFitReport(fit, options.data_path), "--report");
 }
 
 }  // namespace driftlab::cli

@@ -47,18 +47,6 @@ void PrintFit(const v1::CalibrationFitResult& fit) {
   for (const std::string& m : fit.messages()) fmt::print("  note: {}\n", m);
 }
 
-bool WriteText(const std::string& path, const std::string& text, const char* option) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out << text;
-  out.close();
-  if (!out) {
-    fmt::print(stderr, "error: {}: cannot write '{}'\n", option, path);
-    return false;
-  }
-  fmt::print("wrote {}\n", path);
-  return true;
-}
-
 int RunCalibrate(CalibrateOptions o) {
   v1::CalibrationResult result;
   try {
@@ -85,12 +73,9 @@ int RunCalibrate(CalibrateOptions o) {
     fmt::print(stderr, "error: cannot convert the result to JSON\n");
     return kExitFailure;
   }
-  if (!WriteText(o.out_path, json, "--out")) return kExitFailure;
-  if (!o.report_path.empty() &&
-      !WriteText(o.report_path, jobspec::RenderCalibrationReport(result), "--report")) {
-    return kExitFailure;
-  }
-  return kExitOk;
+  if (const int status = WriteOutputText(o.out_path, json, "--out")) return status;
+  if (o.report_path.empty()) return kExitOk;
+  return WriteOutputText(o.report_path, jobspec::RenderCalibrationReport(result), "--report");
 }
 
 const RegisterCommand kCalibrate("calibrate", [](CLI::App& app) -> std::function<int()> {

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace driftlab::cli {
@@ -26,6 +27,16 @@ struct CommandEntry {
 
 // All registered commands (static registration from each command's file).
 std::vector<CommandEntry>& CommandRegistry();
+
+// Writes `text` to `path` safely (output_files.h: temporary file, fsync, rename; never over
+// anything but a regular file) and prints "wrote PATH". Returns kExitOk, kExitBadJob when the
+// target is refused (the message names `option`), or kExitFailure on an I/O error; errors on
+// stderr. Every command's file output goes through it.
+int WriteOutputText(const std::string& path, std::string_view text, const std::string& option);
+
+// Refuses an output path before the work starts (CheckOutputPath): prints the error and returns
+// false when `path` exists and is not a regular file or its directory does not exist.
+bool OutputPathUsable(const std::string& path, const std::string& option);
 
 struct RegisterCommand {
   RegisterCommand(std::string name, AddCommand add) {

@@ -40,15 +40,7 @@ int RunDatasheet(const std::string& path, const std::string& out_path) {
     fmt::print("{}", json);
     return kExitOk;
   }
-  std::ofstream out(out_path, std::ios::binary | std::ios::trunc);
-  out << json;
-  out.close();
-  if (!out) {
-    fmt::print(stderr, "error: --out: cannot write '{}'\n", out_path);
-    return kExitFailure;
-  }
-  fmt::print("wrote {}\n", out_path);
-  return kExitOk;
+  return WriteOutputText(out_path, json, "--out");
 }
 
 const RegisterCommand kDatasheet("datasheet", [](CLI::App& app) -> std::function<int()> {

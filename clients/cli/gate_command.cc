@@ -53,13 +53,9 @@ int RunGateCommand(const GateOptions& options) {
   }
   fmt::print("{}", jobspec::FormatGateTable(report));
   if (!options.junit_path.empty()) {
-    std::ofstream out(options.junit_path, std::ios::binary | std::ios::trunc);
-    if (out) out << jobspec::RenderJunitXml(report);
-    if (out) out.close();
-    if (!out) {
-      fmt::print(stderr, "error: --junit {}: cannot write: {}\n", options.junit_path,
-                 std::strerror(errno));
-      return kExitBadJob;
+    if (const int status =
+            WriteOutputText(options.junit_path, jobspec::RenderJunitXml(report), "--junit")) {
+      return status;
     }
   }
   return report.passed() ? kExitOk : kExitFailure;

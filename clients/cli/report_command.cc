@@ -30,15 +30,7 @@ int RunReport(const ReportOptions& options) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;
   }
-  std::ofstream out(options.out_path, std::ios::binary | std::ios::trunc);
-  if (out) out << html;
-  if (out) out.close();
-  if (!out) {
-    fmt::print(stderr, "error: {}: cannot write: {}\n", options.out_path, std::strerror(errno));
-    return kExitFailure;
-  }
-  fmt::print("wrote {} ({} bytes)\n", options.out_path, html.size());
-  return kExitOk;
+  return WriteOutputText(options.out_path, html, "--out");
 }
 
 const RegisterCommand kReport("report", [](CLI::App& app) -> std::function<int()> {

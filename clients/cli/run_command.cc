@@ -31,6 +31,7 @@
 #include "driftlab/jobspec/monte_carlo_job.h"
 #include "driftlab/jobspec/result_file.h"
 #include "driftlab/monte_carlo.h"
+#include "driftlab/output_files.h"
 #include "driftlab/spec_error.h"
 #include "progress.h"
 #include "remote.h"
@@ -86,10 +87,7 @@ void WriteOutputs(const v1::JobResult& result, const std::string& out,
     if (report_path.has_parent_path()) {
       std::filesystem::create_directories(report_path.parent_path());
     }
-    std::ofstream file(report_path, std::ios::binary | std::ios::trunc);
-    file << jobspec::RenderHtmlReport(result);
-    file.close();
-    if (!file) throw SpecError(*report, "cannot write the report", 0);
+    WriteOutputFile(report_path, jobspec::RenderHtmlReport(result), "--report");
     fmt::print("wrote {}\n", *report);
   }
 }

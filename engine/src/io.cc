@@ -259,10 +259,8 @@ MotionSpec TruthProfileMotion(std::vector<TruthProfileSample> samples, EarthMode
 
 CsvFile::CsvFile(const std::filesystem::path& path, const std::string& header)
     : path_(path), buffer_(1 << 20) {
-  file_ = std::fopen(path.string().c_str(), "w");
-  if (file_ == nullptr) {
-    throw std::runtime_error(path.string() + ": cannot create (" + std::strerror(errno) + ")");
-  }
+  output_ = std::make_unique<OutputFile>(path, path.string());
+  file_ = output_->stream();
   std::setvbuf(file_, buffer_.data(), _IOFBF, buffer_.size());
   if (!header.empty()) {
     std::fputs(header.c_str(), file_);
@@ -270,16 +268,14 @@ CsvFile::CsvFile(const std::filesystem::path& path, const std::string& header)
   }
 }
 
-CsvFile::~CsvFile() {
-  if (file_ != nullptr) std::fclose(file_);
-}
+// Without Close(), output_'s destructor removes the temporary file (before buffer_ goes).
+CsvFile::~CsvFile() { output_.reset(); }
 
 void CsvFile::Close() {
-  if (file_ == nullptr) return;
-  const bool failed = std::ferror(file_) != 0;
-  const int rc = std::fclose(file_);
+  if (!output_) return;
   file_ = nullptr;
-  if (failed || rc != 0) throw std::runtime_error(path_.string() + ": write error");
+  output_->Commit();
+  output_.reset();
 }
 
 void CsvFile::Row(const double* values, int count) {
@@ -293,7 +289,8 @@ void CsvFile::Row(const double* values, int count) {
   }
   *p++ = '\n';
   if (std::fwrite(line, 1, static_cast<size_t>(p - line), file_) != static_cast<size_t>(p - line)) {
-    throw std::runtime_error(path_.string() + ": write error");
+    throw OutputError(path_.string() + ": cannot write: write error (" + std::strerror(errno) +
+                      ")");
   }
 }
 

@@ -21,6 +21,7 @@
 
 #include "driftlab/server/auth.h"
 #include "driftlab/server/server.h"
+#include "driftlab/output_files.h"
 #include "driftlab/spec_error.h"
 
 namespace {
@@ -33,13 +34,7 @@ std::string BoundAddress(const std::string& listen, int port) {
 }
 
 void WritePortFile(const std::filesystem::path& path, int port) {
-  const std::filesystem::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    out << port << "\n";
-    if (!out) throw driftlab::SpecError("--port-file", path.string(), "a writable file");
-  }
-  std::filesystem::rename(tmp, path);
+  driftlab::WriteOutputFile(path, std::to_string(port) + "\n", "--port-file");
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 
 #include "driftlab/input_files.h"
 #include "driftlab/jobspec/json_syntax.h"
+#include "driftlab/output_files.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::jobspec {
@@ -310,21 +311,9 @@ void WriteJobResult(const std::filesystem::path& path, const v1::JobResult& resu
     throw SpecError(name, std::string("refusing to write an invalid result: ") + e.what(), 0);
   }
   const std::string json = JobResultToJson(result);
-  // Written next to the target and renamed over it: a reader never sees half a file.
-  const std::filesystem::path temporary = path.string() + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) throw SpecError(name, fmt::format("cannot write: {}", std::strerror(errno)), 0);
-    out << json;
-    out.close();
-    if (!out) throw SpecError(name, fmt::format("cannot write: {}", std::strerror(errno)), 0);
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::filesystem::remove(temporary, error);
-    throw SpecError(name, "cannot write: " + error.message(), 0);
-  }
+  // A temporary file beside the target, synced and renamed over it (output_files.h): a reader
+  // never sees half a file, and nothing but a regular file is replaced.
+  WriteOutputFile(path, json, name);
 }
 
 }  // namespace driftlab::jobspec

@@ -21,12 +21,14 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <istream>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "driftlab/nav_state.h"
+#include "driftlab/output_files.h"
 #include "driftlab/simulate.h"
 #include "driftlab/trajectory.h"
 
@@ -46,16 +48,18 @@ std::vector<TruthProfileSample> ReadTruthProfile(std::istream& in, const std::st
 MotionSpec TruthProfileMotion(std::vector<TruthProfileSample> samples,
                               EarthModel earth_model = EarthModel::kWgs84);
 
-// Base of the CSV writers: owns the file, writes the header at construction. Throws
-// std::runtime_error naming the file if it cannot be opened or written.
+// Base of the CSV writers: owns the file, writes the header at construction. The rows go to a
+// temporary file beside the target (output_files.h), which Close() renames over the target; a
+// writer destroyed without Close() (an error, a cancellation) leaves no file behind, so a CSV
+// either is complete or does not exist. Throws SpecError naming the file if the target is not a
+// regular file, OutputError if it cannot be written.
 class CsvFile {
  public:
   CsvFile(const std::filesystem::path& path, const std::string& header);
   ~CsvFile();
   CsvFile(const CsvFile&) = delete;
   CsvFile& operator=(const CsvFile&) = delete;
-  // Flushes and closes; reports a write error. Called by the destructor if not called before
-  // (which then cannot report).
+  // Flushes, syncs and renames the file into place; reports a write error.
   void Close();
 
  protected:
@@ -64,6 +68,7 @@ class CsvFile {
 
  private:
   std::filesystem::path path_;
+  std::unique_ptr<OutputFile> output_;
   std::FILE* file_ = nullptr;
   std::vector<char> buffer_;
 };

@@ -1,0 +1,62 @@
+// Writing output files safely (DESIGN.md invariant 10, issue 15): every file driftlab writes
+// (results, reports, CSV data, JUnit XML, models) goes to a temporary file in the target's
+// directory, is flushed to disk (fsync) and renamed over the target, so that a reader never sees
+// half a file and no partial file survives a failure; and a target that exists but is not a
+// regular file (a symbolic link, a device such as /dev/null, a directory, a FIFO) is never
+// replaced: that is refused.
+#pragma once
+
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+namespace driftlab {
+
+// An output could not be written (disk full, permissions, ...): an I/O error, not bad input.
+// One line: "FIELD: cannot write 'PATH': what (system reason)".
+class OutputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Throws SpecError(field, "'PATH' (a symbolic link)", "a new file or a regular file to replace")
+// when `path` exists and is not a regular file. For checking command-line outputs before the work
+// starts. (A missing directory is an I/O error when the file is written: OutputError.)
+void CheckOutputPath(const std::filesystem::path& path, const std::string& field);
+
+// One output file being written. Construction checks the target (CheckOutputPath) and creates
+// the temporary file beside it; Commit() makes it the target; destruction without Commit() removes
+// the temporary. I/O errors are OutputError; a target that is not a regular file is SpecError.
+class OutputFile {
+ public:
+  OutputFile(const std::filesystem::path& path, const std::string& field);
+  ~OutputFile();
+  OutputFile(const OutputFile&) = delete;
+  OutputFile& operator=(const OutputFile&) = delete;
+
+  // The temporary file's stream (fully buffered with the given buffer, if any).
+  std::FILE* stream() { return file_; }
+  void Write(std::string_view data);
+  // Checks the stream, fsyncs, closes and renames the temporary over the target (then fsyncs the
+  // directory). Throws OutputError on any failure (the temporary is removed then).
+  void Commit();
+
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  [[noreturn]] void Fail(const std::string& what, int error_number);
+
+  std::filesystem::path path_;
+  std::filesystem::path temporary_;
+  std::string field_;
+  std::FILE* file_ = nullptr;
+  bool committed_ = false;
+};
+
+// OutputFile for a whole content at once.
+void WriteOutputFile(const std::filesystem::path& path, std::string_view content,
+                     const std::string& field);
+
+}  // namespace driftlab

@@ -1,0 +1,122 @@
+// Safe output files (output_files.h): temporary file beside the target, fsync, rename.
+#include "driftlab/output_files.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <vector>
+
+#include "driftlab/spec_error.h"
+
+namespace driftlab {
+namespace {
+
+std::string KindOf(mode_t mode) {
+  if (S_ISLNK(mode)) return "a symbolic link";
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+std::filesystem::path DirectoryOf(const std::filesystem::path& path) {
+  return path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+}
+
+}  // namespace
+
+void CheckOutputPath(const std::filesystem::path& path, const std::string& field) {
+  if (path.empty() || !path.has_filename()) {
+    throw SpecError(field, "'" + path.string() + "'", "a file path");
+  }
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) == 0) {
+    if (!S_ISREG(st.st_mode)) {
+      throw SpecError(field, "'" + path.string() + "' (" + KindOf(st.st_mode) + ")",
+                      "a new file or a regular file to replace (driftlab never writes over "
+                      "anything else)");
+    }
+  } else if (errno != ENOENT) {
+    throw SpecError(field, "'" + path.string() + "' (" + std::strerror(errno) + ")",
+                    "a writable path");
+  }
+}
+
+OutputFile::OutputFile(const std::filesystem::path& path, const std::string& field)
+    : path_(path), field_(field) {
+  CheckOutputPath(path, field);
+  std::string pattern =
+      (DirectoryOf(path) / ("." + path.filename().string() + ".tmp-XXXXXX")).string();
+  std::vector<char> name(pattern.begin(), pattern.end());
+  name.push_back('\0');
+  const int fd = ::mkstemp(name.data());
+  if (fd < 0) Fail("cannot create a temporary file beside it", errno);
+  temporary_ = name.data();
+  // mkstemp makes the file 0600; outputs are ordinary files (0666 less the umask).
+  const mode_t mask = ::umask(0);
+  ::umask(mask);
+  ::fchmod(fd, 0666 & ~mask);
+  file_ = ::fdopen(fd, "w");
+  if (file_ == nullptr) {
+    const int error_number = errno;
+    ::close(fd);
+    Fail("cannot open the temporary file", error_number);
+  }
+}
+
+OutputFile::~OutputFile() {
+  if (file_ != nullptr) std::fclose(file_);
+  if (!committed_ && !temporary_.empty()) ::unlink(temporary_.c_str());
+}
+
+void OutputFile::Fail(const std::string& what, int error_number) {
+  if (file_ != nullptr) {
+    std::fclose(file_);
+    file_ = nullptr;
+  }
+  if (!temporary_.empty()) ::unlink(temporary_.c_str());
+  temporary_.clear();
+  throw OutputError(MessageText(field_, kMaxMessageFieldBytes) + ": cannot write '" +
+                    MessageText(path_.string(), kMaxMessageValueBytes) + "': " + what +
+                    (error_number != 0 ? std::string(" (") + std::strerror(error_number) + ")"
+                                       : std::string()));
+}
+
+void OutputFile::Write(std::string_view data) {
+  if (std::fwrite(data.data(), 1, data.size(), file_) != data.size()) Fail("write error", errno);
+}
+
+void OutputFile::Commit() {
+  if (std::fflush(file_) != 0 || std::ferror(file_) != 0) Fail("write error", errno);
+  if (::fsync(::fileno(file_)) != 0 && errno != EINVAL) Fail("fsync failed", errno);
+  const int rc = std::fclose(file_);
+  file_ = nullptr;
+  if (rc != 0) Fail("close failed", errno);
+  // The target may have been replaced by something else since the check: refuse it then too.
+  struct stat st {};
+  if (::lstat(path_.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+    Fail("it became " + KindOf(st.st_mode), 0);
+  }
+  if (std::rename(temporary_.c_str(), path_.c_str()) != 0) Fail("rename failed", errno);
+  committed_ = true;
+  // The rename is durable once the directory is on disk.
+  const int dir = ::open(DirectoryOf(path_).c_str(), O_RDONLY | O_DIRECTORY);
+  if (dir >= 0) {
+    ::fsync(dir);
+    ::close(dir);
+  }
+}
+
+void WriteOutputFile(const std::filesystem::path& path, std::string_view content,
+                     const std::string& field) {
+  OutputFile file(path, field);
+  file.Write(content);
+  file.Commit();
+}
+
+}  // namespace driftlab
