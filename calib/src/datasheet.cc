@@ -1,6 +1,8 @@
 // Datasheet summary -> ImuErrorModel (datasheet.h documents the file format and the keys).
 #include "driftlab/calib/datasheet.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -8,10 +10,8 @@
 #include <set>
 #include <sstream>
 
-#include <yaml-cpp/yaml.h>
-
-#include "driftlab/sensors.h"
 #include "driftlab/input_files.h"
+#include "driftlab/sensors.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::calib {
@@ -147,15 +147,14 @@ std::vector<DatasheetEntry> ParseDatasheetText(std::string_view text, std::strin
   try {
     documents = YAML::LoadAll(std::string(text));
   } catch (const YAML::Exception& e) {
-    throw SpecError(Where(source, e.mark.line + 1),
-                    "invalid YAML (" + e.msg + ")", "a YAML mapping of name, description, gyro, "
+    throw SpecError(Where(source, e.mark.line + 1), "invalid YAML (" + e.msg + ")",
+                    "a YAML mapping of name, description, gyro, "
                     "accel");
   }
   if (documents.size() != 1 || !documents.front().IsMap() || documents.front().size() == 0) {
-    const bool empty =
-        documents.empty() || (documents.size() == 1 && documents.front().IsNull());
+    const bool empty = documents.empty() || (documents.size() == 1 && documents.front().IsNull());
     throw SpecError(std::string(source),
-                    empty                   ? std::string("an empty datasheet")
+                    empty                  ? std::string("an empty datasheet")
                     : documents.size() > 1 ? std::to_string(documents.size()) + " YAML documents"
                                            : std::string("not a mapping of keys"),
                     "one YAML document: a mapping of name, description, gyro, accel with at "

@@ -93,8 +93,8 @@ int RunAllanFit(const AllanFitOptions& options) {
     if (const int status = WriteOutputText(options.out_path, json, "--out")) return status;
   }
   if (options.report_path.empty()) return kExitOk;
-  return WriteOutputText(options.report_path,
-                         jobspec::RenderNoiseFitReport(fit, options.data_path), "--report");
+  return WriteOutputText(options.report_path, jobspec::RenderNoiseFitReport(fit, options.data_path),
+                         "--report");
 }
 
 }  // namespace driftlab::cli

@@ -4,7 +4,10 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <functional>
+#include <limits>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -37,6 +40,34 @@ int WriteOutputText(const std::string& path, std::string_view text, const std::s
 // Refuses an output path before the work starts (CheckOutputPath): prints the error and returns
 // false when `path` exists and is not a regular file or its directory does not exist.
 bool OutputPathUsable(const std::string& path, const std::string& option);
+
+// Unsigned integer options parsed strictly (CLI11 would wrap "-1" or 2^64 to 2^64 - 1 and skip an
+// empty value): decimal digits only, within [min, max]; anything else is a one-line error naming
+// the option, the value and the allowed range (exit 2).
+uint64_t ParseUnsignedOption(const std::string& option, const std::string& text, uint64_t min,
+                             uint64_t max);
+template <typename T>
+CLI::Option* AddUnsignedOption(CLI::App* command, const std::string& name, std::optional<T>* value,
+                               const std::string& help, uint64_t min = 0,
+                               uint64_t max = std::numeric_limits<T>::max()) {
+  return command->add_option_function<std::string>(
+      name,
+      [name, value, min, max](const std::string& text) {
+        *value = static_cast<T>(ParseUnsignedOption(name, text, min, max));
+      },
+      help);
+}
+template <typename T>
+CLI::Option* AddUnsignedOption(CLI::App* command, const std::string& name, T* value,
+                               const std::string& help, uint64_t min = 0,
+                               uint64_t max = std::numeric_limits<T>::max()) {
+  return command->add_option_function<std::string>(
+      name,
+      [name, value, min, max](const std::string& text) {
+        *value = static_cast<T>(ParseUnsignedOption(name, text, min, max));
+      },
+      help);
+}
 
 struct RegisterCommand {
   RegisterCommand(std::string name, AddCommand add) {

@@ -253,8 +253,9 @@ const RegisterCommand kExport("export", [](CLI::App& app) -> std::function<int()
   command->add_option("job", options->job_path, "Job file (.json, .yaml, .yml)")->required();
   command->add_option("--out,-o", options->out_dir, "Output directory (created if absent)")
       ->required();
-  command->add_option("--seed", options->seed, "Random seed (default: the job's monte_carlo.seed)");
-  command->add_option("--run", options->run_index, "Run index")->capture_default_str();
+  AddUnsignedOption(command, "--seed", &options->seed,
+                    "Random seed (default: the job's monte_carlo.seed)");
+  AddUnsignedOption(command, "--run", &options->run_index, "Run index (default 0)");
   CLI::Option* server = AddRemoteOptions(command, &options->remote, /*server_required=*/false);
   command
       ->add_flag("--navigation", options->navigation,

@@ -2,12 +2,14 @@
 // (commands.h; one file per command) and runs the one given.
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cstdio>
 #include <functional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "commands.h"
+#include "driftlab/spec_error.h"
 
 namespace driftlab::cli {
 
@@ -34,9 +36,12 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int status = app.exit(e);
-    // --help and --version exit 0; a wrong command line is bad input like a bad job.
-    return status == 0 ? driftlab::cli::kExitOk : driftlab::cli::kExitBadJob;
+    // --help and --version print and exit 0; a wrong command line is bad input like a bad job,
+    // reported on one line (CLI11's own text spans two).
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::fprintf(stderr, "error: %s (see driftlab --help)\n",
+                 driftlab::MessageText(e.what(), driftlab::kMaxMessageTextBytes).c_str());
+    return driftlab::cli::kExitBadJob;
   }
   const auto subcommands = app.get_subcommands();
   const CLI::App* given = subcommands.front();

@@ -1,6 +1,7 @@
-// WriteOutputText and OutputPathUsable (commands.h): the CLI's file outputs.
+// The CLI's shared option parsing and file outputs (commands.h).
 #include <fmt/format.h>
 
+#include <charconv>
 #include <cstdio>
 
 #include "commands.h"
@@ -8,6 +9,22 @@
 #include "driftlab/spec_error.h"
 
 namespace driftlab::cli {
+
+uint64_t ParseUnsignedOption(const std::string& option, const std::string& text, uint64_t min,
+                             uint64_t max) {
+  uint64_t value = 0;
+  const char* end = text.data() + text.size();
+  const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+  const auto [ptr, ec] = std::from_chars(text.data(), end, value);
+  if (!digits || ec != std::errc() || ptr != end || value < min || value > max) {
+    throw CLI::ValidationError(
+        option, fmt::format("{} is not allowed; allowed: an integer from {} to {} (decimal digits)",
+                            text.empty() ? std::string("an empty value")
+                                         : "'" + MessageText(text, 40) + "'",
+                            min, max));
+  }
+  return value;
+}
 
 int WriteOutputText(const std::string& path, std::string_view text, const std::string& option) {
   try {

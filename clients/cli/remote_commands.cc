@@ -268,8 +268,10 @@ const RegisterCommand kSubmit("submit", [](CLI::App& app) -> std::function<int()
   CLI::App* command =
       app.add_subcommand("submit", "Submit a job to a driftlab-server; prints the job id");
   command->add_option("job", options->job_path, "Job file (.json, .yaml, .yml)")->required();
-  command->add_option("--runs", options->runs, "Runs (default: the job's monte_carlo.runs)");
-  command->add_option("--seed", options->seed, "Seed (default: the job's monte_carlo.seed)");
+  AddUnsignedOption(command, "--runs", &options->runs,
+                    "Runs (default: the job's monte_carlo.runs)");
+  AddUnsignedOption(command, "--seed", &options->seed,
+                    "Seed (default: the job's monte_carlo.seed)");
   command->add_option("--shard", options->shard, "Run only shard i of K (i/K, 0 <= i < K)");
   command->add_option("--deadline", options->deadline_s,
                       "Cancel the job when it has not finished this many seconds after "
@@ -332,8 +334,9 @@ const RegisterCommand kScore("score", [](CLI::App& app) -> std::function<int()> 
                    "v_north_m_per_s, v_east_m_per_s, v_down_m_per_s, roll_deg, pitch_deg, "
                    "yaw_deg; any order), then one row per epoch")
       ->required();
-  command->add_option("--seed", options->seed, "Random seed (default: the job's monte_carlo.seed)");
-  command->add_option("--run", options->run_index, "Run index (default 0)");
+  AddUnsignedOption(command, "--seed", &options->seed,
+                    "Random seed (default: the job's monte_carlo.seed)");
+  AddUnsignedOption(command, "--run", &options->run_index, "Run index (default 0)");
   command->add_option("--out,-o", options->out, "Result file (.json)")->required();
   command->add_option("--report", options->report, "Also write this HTML report");
   AddRemoteOptions(command, &options->remote, /*server_required=*/true);

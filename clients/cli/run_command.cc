@@ -208,8 +208,10 @@ const RegisterCommand kRun("run", [](CLI::App& app) -> std::function<int()> {
   command->add_option("job", options->job_path, "Job file (.json, .yaml, .yml)")->required();
   command->add_option("--out,-o", options->out, "Result file (.json)")->required();
   command->add_option("--report", options->report, "Also write this HTML report");
-  command->add_option("--runs", options->runs, "Runs (default: the job's monte_carlo.runs)");
-  command->add_option("--seed", options->seed, "Seed (default: the job's monte_carlo.seed)");
+  AddUnsignedOption(command, "--runs", &options->runs,
+                    "Runs (default: the job's monte_carlo.runs)");
+  AddUnsignedOption(command, "--seed", &options->seed,
+                    "Seed (default: the job's monte_carlo.seed)");
   command->add_option("--threads", options->threads, "Worker threads (default 0 = all cores)");
   command->add_option("--shard", options->shard,
                       "Run only shard i of K (i/K, 0 <= i < K); combine with `driftlab merge`");

@@ -115,8 +115,9 @@ const RegisterCommand kSimulate("simulate", [](CLI::App& app) -> std::function<i
   command->add_option("job", options->job_path, "Job file (.json, .yaml, .yml)")->required();
   command->add_option("--out,-o", options->out_dir, "Output directory (created if absent)")
       ->capture_default_str();
-  command->add_option("--seed", options->seed, "Random seed (default: the job's monte_carlo.seed)");
-  command->add_option("--run", options->run_index, "Run index of the sensor errors")
+  AddUnsignedOption(command, "--seed", &options->seed,
+                    "Random seed (default: the job's monte_carlo.seed)");
+  AddUnsignedOption(command, "--run", &options->run_index, "Run index of the sensor errors")
       ->capture_default_str();
   return [options] { return RunSimulate(*options); };
 });

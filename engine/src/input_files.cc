@@ -98,9 +98,10 @@ bool ReadLine(std::istream& in, std::string* line, const std::string& where, siz
     any = true;
     if (c == '\n') break;
     if (line->size() == max_bytes) {
-      throw SpecError(where, "a line longer than " + std::to_string(max_bytes) +
-                                 " bytes; allowed: lines of at most " + std::to_string(max_bytes) +
-                                 " bytes",
+      throw SpecError(where,
+                      "a line longer than " + std::to_string(max_bytes) +
+                          " bytes; allowed: lines of at most " + std::to_string(max_bytes) +
+                          " bytes",
                       0);
     }
     line->push_back(static_cast<char>(c));

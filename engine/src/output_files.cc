@@ -81,10 +81,10 @@ void OutputFile::Fail(const std::string& what, int error_number) {
   }
   if (!temporary_.empty()) ::unlink(temporary_.c_str());
   temporary_.clear();
-  throw OutputError(MessageText(field_, kMaxMessageFieldBytes) + ": cannot write '" +
-                    MessageText(path_.string(), kMaxMessageValueBytes) + "': " + what +
-                    (error_number != 0 ? std::string(" (") + std::strerror(error_number) + ")"
-                                       : std::string()));
+  throw OutputError(
+      MessageText(field_, kMaxMessageFieldBytes) + ": cannot write '" +
+      MessageText(path_.string(), kMaxMessageValueBytes) + "': " + what +
+      (error_number != 0 ? std::string(" (") + std::strerror(error_number) + ")" : std::string()));
 }
 
 void OutputFile::Write(std::string_view data) {

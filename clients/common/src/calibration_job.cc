@@ -20,8 +20,8 @@
 #include "driftlab/calib/noise_fit.h"
 #include "driftlab/calib/reference_calibration.h"
 #include "driftlab/calib/static_detection.h"
-#include "driftlab/jobspec/sensor_model_json.h"
 #include "driftlab/input_files.h"
+#include "driftlab/jobspec/sensor_model_json.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/units.h"
 #include "field_checks.h"
@@ -112,8 +112,7 @@ NumericTable ReadCsv(const std::string& path, const std::vector<std::string>* se
   }
   for (size_t i = 0; i < header.size(); ++i) {
     if (header[i].size() > kMaxCsvColumnNameBytes) {
-      throw SpecError(fmt::format("{}:{}: column {}", path, line_no, i + 1),
-                      "'" + header[i] + "'",
+      throw SpecError(fmt::format("{}:{}: column {}", path, line_no, i + 1), "'" + header[i] + "'",
                       fmt::format("a column name of at most {} bytes", kMaxCsvColumnNameBytes));
     }
     for (size_t j = 0; j < i; ++j) {

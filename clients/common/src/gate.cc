@@ -12,8 +12,8 @@
 #include <sstream>
 #include <unordered_map>
 
-#include "driftlab/jobspec/result_file.h"
 #include "driftlab/input_files.h"
+#include "driftlab/jobspec/result_file.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::jobspec {

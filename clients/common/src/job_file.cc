@@ -11,9 +11,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "driftlab/input_files.h"
 #include "driftlab/jobspec/json_syntax.h"
 #include "driftlab/jobspec/schema_check.h"
-#include "driftlab/input_files.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::jobspec {

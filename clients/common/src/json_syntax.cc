@@ -88,8 +88,7 @@ class JsonSyntax {
       } else if (Literal("true") || Literal("false") || Literal("null")) {
       } else {
         Fail(AtEnd() ? "the text ends where a value was expected"
-                     : fmt::format("unexpected character {} where a value was expected",
-                                   Shown(c)));
+                     : fmt::format("unexpected character {} where a value was expected", Shown(c)));
       }
       // After a complete value: close containers or move to the next element / member.
       for (;;) {
@@ -122,7 +121,8 @@ class JsonSyntax {
     }
     String();
     SkipSpace();
-    if (Peek() != ':') Fail(fmt::format("expected ':' after a member name, found {}", Shown(Peek())));
+    if (Peek() != ':')
+      Fail(fmt::format("expected ':' after a member name, found {}", Shown(Peek())));
     ++pos_;
   }
 

@@ -16,12 +16,12 @@ namespace driftlab {
 
 // Size limits of each kind of input file [bytes]. Generous for real data: a 10-hour 100 Hz
 // 7-column recording is ~0.3 GB of CSV; a job file of 20 000 epochs ~0.5 MB.
-inline constexpr uint64_t kMaxJobFileBytes = 16ull << 20;         // job files (JSON / YAML)
-inline constexpr uint64_t kMaxSmallTextFileBytes = 1ull << 20;    // datasheets, gate rules, tokens
-inline constexpr uint64_t kMaxMotionFileBytes = 256ull << 20;     // motion / truth-profile CSV
-inline constexpr uint64_t kMaxRecordingFileBytes = 16ull << 30;   // sensor recordings (CSV)
-inline constexpr uint64_t kMaxResultFileBytes = 4ull << 30;       // result JSON files
-inline constexpr size_t kMaxLineBytes = 1 << 20;                  // one line of a text file
+inline constexpr uint64_t kMaxJobFileBytes = 16ull << 20;        // job files (JSON / YAML)
+inline constexpr uint64_t kMaxSmallTextFileBytes = 1ull << 20;   // datasheets, gate rules, tokens
+inline constexpr uint64_t kMaxMotionFileBytes = 256ull << 20;    // motion / truth-profile CSV
+inline constexpr uint64_t kMaxRecordingFileBytes = 16ull << 30;  // sensor recordings (CSV)
+inline constexpr uint64_t kMaxResultFileBytes = 4ull << 30;      // result JSON files
+inline constexpr size_t kMaxLineBytes = 1 << 20;                 // one line of a text file
 
 // Opens `path` for reading after checking that it is a regular file of at most max_bytes bytes
 // (symbolic links are followed). Throws SpecError(field, ...) naming the path otherwise, or when

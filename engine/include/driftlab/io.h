@@ -21,8 +21,8 @@
 
 #include <cstdio>
 #include <filesystem>
-#include <memory>
 #include <istream>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>

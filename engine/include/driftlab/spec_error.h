@@ -30,11 +30,10 @@ class SpecError : public std::runtime_error {
  public:
   // message: "<field>: <value> is not allowed; allowed: <range>".
   SpecError(const std::string& field, const std::string& value, const std::string& allowed)
-      : std::runtime_error(MessageText(field, kMaxMessageFieldBytes) + ": " +
-                           (value.empty() ? std::string("missing")
-                                          : MessageText(value, kMaxMessageValueBytes)) +
-                           " is not allowed; allowed: " +
-                           MessageText(allowed, kMaxMessageTextBytes)),
+      : std::runtime_error(
+            MessageText(field, kMaxMessageFieldBytes) + ": " +
+            (value.empty() ? std::string("missing") : MessageText(value, kMaxMessageValueBytes)) +
+            " is not allowed; allowed: " + MessageText(allowed, kMaxMessageTextBytes)),
         field_(MessageText(field, kMaxMessageFieldBytes)) {}
   // Free-form message for errors that are not a single value out of range (e.g. a bad file line).
   SpecError(const std::string& field, const std::string& message, int)
