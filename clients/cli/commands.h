@@ -69,6 +69,9 @@ CLI::Option* AddUnsignedOption(CLI::App* command, const std::string& name, T* va
       help);
 }
 
+// --max-memory-gb G as bytes (0 = no limit); SpecError for a negative or non-finite G.
+uint64_t MemoryLimitBytes(double gigabytes);
+
 struct RegisterCommand {
   RegisterCommand(std::string name, AddCommand add) {
     CommandRegistry().push_back({std::move(name), std::move(add)});

@@ -40,6 +40,13 @@ int WriteOutputText(const std::string& path, std::string_view text, const std::s
   return kExitOk;
 }
 
+uint64_t MemoryLimitBytes(double gigabytes) {
+  if (!(gigabytes >= 0.0) || gigabytes > 1e6) {
+    throw SpecError("--max-memory-gb", fmt::format("{}", gigabytes), "0 (no limit) to 1e6 GB");
+  }
+  return static_cast<uint64_t>(gigabytes * 1e9);
+}
+
 bool OutputPathUsable(const std::string& path, const std::string& option) {
   try {
     CheckOutputPath(path, option);

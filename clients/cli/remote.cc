@@ -5,12 +5,14 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 
 #include "commands.h"
+#include "driftlab/input_files.h"
 #include "driftlab/jobspec/job_file.h"
 #include "driftlab/spec_error.h"
 #include "interrupt.h"
@@ -61,6 +63,31 @@ const char* CodeName(grpc::StatusCode code) {
   }
 }
 
+// A bearer token as RFC 6750 section 2.1 defines it (b64token: letters, digits, "-._~+/", then
+// "=" padding), at most 4096 characters. Surrounding whitespace, as a token pasted with a Windows
+// line ending carries, is removed; any other byte is refused here: gRPC aborts on metadata values
+// with control or non-ASCII bytes.
+std::string CheckToken(std::string& token) {
+  const size_t first = token.find_first_not_of(" \t\r\n");
+  const size_t last = token.find_last_not_of(" \t\r\n");
+  token = first == std::string::npos ? std::string() : token.substr(first, last - first + 1);
+  size_t i = 0;
+  while (i < token.size() && (std::isalnum(static_cast<unsigned char>(token[i])) ||
+                              std::string_view("-._~+/").find(token[i]) != std::string::npos)) {
+    ++i;
+  }
+  while (i < token.size() && token[i] == '=') ++i;
+  if (token.size() > 4096 || (!token.empty() && i == 0) || i != token.size()) {
+    return fmt::format(
+        "a token with {} is not allowed; allowed: at most 4096 characters of letters, digits "
+        "and -._~+/ (then = padding), as RFC 6750 bearer tokens",
+        token.size() > 4096 ? fmt::format("{} characters", token.size())
+                            : fmt::format("the byte 0x{:02X} at position {}",
+                                          static_cast<unsigned char>(token[i]), i + 1));
+  }
+  return "";
+}
+
 }  // namespace
 
 CLI::Option* AddRemoteOptions(CLI::App* command, RemoteOptions* options, bool server_required) {
@@ -72,7 +99,8 @@ CLI::Option* AddRemoteOptions(CLI::App* command, RemoteOptions* options, bool se
   command
       ->add_option("--token", options->token,
                    "Bearer token for the server (default: environment DRIFTLAB_TOKEN)")
-      ->envname("DRIFTLAB_TOKEN");
+      ->envname("DRIFTLAB_TOKEN")
+      ->transform(CLI::Validator(CheckToken, "TOKEN"));
   command->add_option("--tls-ca", options->tls_ca,
                       "PEM file of the CA that signed the server's certificate (enables TLS)");
   return server;
@@ -85,14 +113,11 @@ std::shared_ptr<grpc::Channel> MakeChannel(const RemoteOptions& options) {
   if (options.tls_ca.empty()) {
     return grpc::CreateCustomChannel(options.server, grpc::InsecureChannelCredentials(), arguments);
   }
-  std::ifstream file(options.tls_ca, std::ios::binary);
-  std::ostringstream pem;
-  pem << file.rdbuf();
-  if (!file || pem.str().empty()) {
-    throw SpecError("--tls-ca", options.tls_ca, "a readable PEM file of CA certificates");
-  }
   grpc::SslCredentialsOptions ssl;
-  ssl.pem_root_certs = pem.str();
+  ssl.pem_root_certs = ReadInputFile(options.tls_ca, kMaxSmallTextFileBytes, "--tls-ca");
+  if (ssl.pem_root_certs.empty()) {
+    throw SpecError("--tls-ca", options.tls_ca, "a PEM file of CA certificates (it is empty)");
+  }
   return grpc::CreateCustomChannel(options.server, grpc::SslCredentials(ssl), arguments);
 }
 
@@ -101,7 +126,8 @@ void PrepareContext(const RemoteOptions& options, grpc::ClientContext* context) 
 }
 
 int ReportRpcError(const grpc::Status& status, const RemoteOptions& options) {
-  const std::string& message = status.error_message();
+  // The server's text, printed as one bounded line whatever it holds.
+  const std::string message = MessageText(status.error_message(), kMaxMessageTextBytes);
   switch (status.error_code()) {
     case grpc::StatusCode::OK:
       return kExitOk;

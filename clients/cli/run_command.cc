@@ -116,6 +116,7 @@ struct RunOptions {
   std::optional<std::string> shard;
   bool quiet = false;
   bool covariance = false;
+  std::optional<double> max_memory_gb;
   RemoteOptions remote;
 };
 
@@ -139,7 +140,13 @@ int RunRun(const RunOptions& options) {
     overrides.seed = options.seed;
     overrides.threads = options.threads;
     overrides.covariance = options.covariance;
+    if (options.max_memory_gb)
+      overrides.max_memory_bytes = MemoryLimitBytes(*options.max_memory_gb);
     if (options.shard) jobspec::ParseShard(*options.shard, &overrides);
+    if (!OutputPathUsable(options.out, "--out") ||
+        (options.report && !OutputPathUsable(*options.report, "--report"))) {
+      return kExitBadJob;
+    }
     spec = jobspec::ToMonteCarloSpec(file, overrides);
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
@@ -216,6 +223,8 @@ const RegisterCommand kRun("run", [](CLI::App& app) -> std::function<int()> {
   command->add_option("--shard", options->shard,
                       "Run only shard i of K (i/K, 0 <= i < K); combine with `driftlab merge`");
   command->add_flag("--quiet,-q", options->quiet, "No progress output");
+  command->add_option("--max-memory-gb", options->max_memory_gb,
+                      "Refuse a job needing more memory than this (default 8 GB; 0 = no limit)");
   command->add_flag(
       "--covariance", options->covariance,
       "Add the linear covariance analysis (predicted sigma of every error component)");

@@ -282,16 +282,18 @@ void ValidateSpec(const MonteCarloSpec& spec) {
   ValidateFilter(spec);
 }
 
-// Generates the truth once and keeps what the runs need (without keep_imu: only the layout, the
-// reports and the start state, for ReplayMonteCarloRun).
-SharedTruth BuildSharedTruth(const MonteCarloSpec& spec, bool keep_imu = true) {
-  TrajectoryGenerator generator(spec.simulation.motion, spec.simulation.rate_hz);
-  SharedTruth s;
-  s.env = generator.environment();
-  s.dt_s = generator.dt_s();
-  s.rate_hz = generator.rate_hz();
-  s.n = generator.num_steps();
-  s.truth0 = generator.initial_state();
+// The layout of a job, from the motion's plan alone (no trajectory streamed): navigation start,
+// the report samples (epochs and checkpoints), with every check that needs the trajectory.
+struct JobPlan {
+  int64_t n = 0;                // output intervals; samples k = 0..n
+  int64_t start_step = 0;       // s0
+  std::vector<Report> reports;  // truth states not filled in
+};
+
+JobPlan PlanJob(const MonteCarloSpec& spec, const TrajectoryGenerator& generator) {
+  JobPlan plan;
+  plan.n = generator.num_steps();
+  const double dt_s = generator.dt_s();
   const bool seed000 = spec.simulation.mechanization == MechanizationKind::kSeed000;
 
   // Navigation start.
@@ -301,29 +303,29 @@ SharedTruth BuildSharedTruth(const MonteCarloSpec& spec, bool keep_imu = true) {
       throw SpecError("navigation.seed000.static_period_s", Num(T),
                       "at most the motion's duration (" + Num(generator.duration_s()) + " s)");
     }
-    s.start_step = std::llround(T / s.dt_s);  // Seed000Options: N = round(T / dt)
+    plan.start_step = std::llround(T / dt_s);  // Seed000Options: N = round(T / dt)
   } else if (spec.initialization == InitializationKind::kStaticAlignment) {
     const double T = spec.alignment.duration_s;
-    s.start_step = std::llround(T / s.dt_s);
-    if (s.start_step < 1 || s.start_step > s.n) {
+    plan.start_step = std::llround(T / dt_s);
+    if (plan.start_step < 1 || plan.start_step > plan.n) {
       throw SpecError("monte_carlo.alignment.duration_s", Num(T),
-                      "[" + Num(s.dt_s) + ", " + Num(generator.duration_s()) +
+                      "[" + Num(dt_s) + ", " + Num(generator.duration_s()) +
                           "] s (at least one IMU sample, at most the trajectory)");
     }
     // Static at every sample of the window and at every kink inside it.
     bool is_static = true;
-    for (int64_t k = 0; k <= s.start_step && is_static; ++k) {
-      is_static = generator.IsStaticAt(static_cast<double>(k) * s.dt_s);
+    for (int64_t k = 0; k <= plan.start_step && is_static; ++k) {
+      is_static = generator.IsStaticAt(static_cast<double>(k) * dt_s);
     }
     for (double t : generator.breakpoints_s()) {
-      if (t <= static_cast<double>(s.start_step) * s.dt_s) is_static &= generator.IsStaticAt(t);
+      if (t <= static_cast<double>(plan.start_step) * dt_s) is_static &= generator.IsStaticAt(t);
     }
     if (!is_static) {
       throw SpecError("monte_carlo.alignment.duration_s", Num(T),
                       "a window over which the trajectory is static (the vehicle moves before " +
-                          Num(static_cast<double>(s.start_step) * s.dt_s) + " s)");
+                          Num(static_cast<double>(plan.start_step) * dt_s) + " s)");
     }
-    if (!spec.alignment.heading_sigma_rad && s.env.model() == EarthModel::kFlat) {
+    if (!spec.alignment.heading_sigma_rad && generator.environment().model() == EarthModel::kFlat) {
       throw SpecError("monte_carlo.alignment.heading_sigma_rad", "",
                       "a 1-sigma > 0 [rad] with the flat Earth model (no Earth rotation to "
                       "gyrocompass on)");
@@ -333,27 +335,29 @@ SharedTruth BuildSharedTruth(const MonteCarloSpec& spec, bool keep_imu = true) {
   // Epochs and checkpoints as sample indices.
   std::vector<int64_t> epoch_k;
   if (spec.epoch_times_s.empty()) {
-    for (int64_t k = s.start_step; k <= s.n; k += spec.epoch_every_samples) {
+    for (int64_t k = plan.start_step; k <= plan.n; k += spec.epoch_every_samples) {
       epoch_k.push_back(k);
       if (epoch_k.size() > kMaxMonteCarloEpochs) break;
     }
-    if (epoch_k.back() != s.n) epoch_k.push_back(s.n);
+    if (epoch_k.back() != plan.n) epoch_k.push_back(plan.n);
     if (epoch_k.size() > kMaxMonteCarloEpochs) {
-      throw SpecError("monte_carlo.epoch_every_samples", std::to_string(spec.epoch_every_samples),
-                      "at least " +
-                          std::to_string((s.n - s.start_step) / (kMaxMonteCarloEpochs - 1) + 1) +
-                          " (at most " + std::to_string(kMaxMonteCarloEpochs) + " epochs)");
+      throw SpecError(
+          "monte_carlo.epoch_every_samples", std::to_string(spec.epoch_every_samples),
+          "at least " +
+              std::to_string((plan.n - plan.start_step) / (kMaxMonteCarloEpochs - 1) + 1) +
+              " (at most " + std::to_string(kMaxMonteCarloEpochs) + " epochs)");
     }
   } else {
     if (spec.epoch_times_s.size() > kMaxMonteCarloEpochs) {
       throw SpecError("monte_carlo.epoch_times_s", std::to_string(spec.epoch_times_s.size()),
                       "at most " + std::to_string(kMaxMonteCarloEpochs) + " epochs");
     }
-    epoch_k = SnapTimes(spec.epoch_times_s, "monte_carlo.epoch_times_s", s.start_step, s.n, s.dt_s);
+    epoch_k =
+        SnapTimes(spec.epoch_times_s, "monte_carlo.epoch_times_s", plan.start_step, plan.n, dt_s);
   }
   std::vector<int64_t> checkpoint_k = SnapTimes(
-      spec.checkpoint_times_s, "monte_carlo.checkpoint_times_s", s.start_step, s.n, s.dt_s);
-  if (checkpoint_k.empty() || checkpoint_k.back() != s.n) checkpoint_k.push_back(s.n);
+      spec.checkpoint_times_s, "monte_carlo.checkpoint_times_s", plan.start_step, plan.n, dt_s);
+  if (checkpoint_k.empty() || checkpoint_k.back() != plan.n) checkpoint_k.push_back(plan.n);
 
   // Merge both ascending lists into the report list.
   size_t i = 0, j = 0;
@@ -365,11 +369,110 @@ SharedTruth BuildSharedTruth(const MonteCarloSpec& spec, bool keep_imu = true) {
     r.k = std::min(ke, kc);
     if (ke == r.k) r.epoch = static_cast<int>(i++);
     if (kc == r.k) r.checkpoint = static_cast<int>(j++);
-    s.reports.push_back(r);
+    plan.reports.push_back(r);
   }
+  ValidateAidingSpec(spec.aiding, generator.rate_hz(), generator.duration_s());
+  return plan;
+}
 
-  // Aiding: validated against the IMU rate and the trajectory's duration.
-  ValidateAidingSpec(spec.aiding, s.rate_hz, generator.duration_s());
+// Memory of a job [bytes] from its plan (EstimateMonteCarloMemoryBytes, monte_carlo.h).
+uint64_t MemoryOfPlan(const MonteCarloSpec& spec, const JobPlan& plan, double rate_hz) {
+  const uint64_t samples = static_cast<uint64_t>(plan.n) + 1;
+  const bool seed000 = spec.simulation.mechanization == MechanizationKind::kSeed000;
+  const bool point_samples = seed000 || spec.filter == NavigationFilterKind::kComplementary;
+  uint64_t bytes = samples * (point_samples ? sizeof(ImuSample) : sizeof(ImuIncrement));
+  if (!seed000 && spec.simulation.ned.vertical == VerticalChannel::kTruthHeight) {
+    bytes += samples * 2 * sizeof(double);
+  }
+  const auto per_rate = [&](double aiding_hz, uint64_t item_bytes) {
+    return aiding_hz > 0.0
+               ? static_cast<uint64_t>(static_cast<double>(samples) * aiding_hz / rate_hz + 1.0) *
+                     item_bytes
+               : uint64_t{0};
+  };
+  if (spec.aiding.gnss) bytes += per_rate(spec.aiding.gnss->rate_hz, sizeof(NavState) + 24);
+  if (spec.aiding.barometer) bytes += per_rate(spec.aiding.barometer->rate_hz, sizeof(double));
+  if (spec.aiding.magnetometer) bytes += per_rate(spec.aiding.magnetometer->rate_hz, 32);
+  if (spec.aiding.zupt) bytes += samples * sizeof(int64_t);
+  size_t epochs = 0, checkpoints = 0;
+  for (const Report& r : plan.reports) {
+    epochs += r.epoch >= 0;
+    checkpoints += r.checkpoint >= 0;
+  }
+  bytes += plan.reports.size() * sizeof(Report);
+  const uint64_t runs = spec.run_count == 0 ? spec.runs - spec.first_run : spec.run_count;
+  // Per-run values at the checkpoints: the engine's, then the result's copy (proto and JSON text,
+  // ~48 bytes a value).
+  bytes += runs * checkpoints * (sizeof(ErrorComponentValues) + kNumErrorComponents * 48);
+  // Per-thread exact sums per epoch (and the NEES sums of a filter), and the result's epochs.
+  const uint64_t threads = spec.threads > 0
+                               ? static_cast<uint64_t>(spec.threads)
+                               : static_cast<uint64_t>(tbb::info::default_concurrency());
+  bytes += (threads + 1) * epochs * (sizeof(EpochSums) + 2 * sizeof(ExactSum));
+  bytes += epochs * kNumErrorComponents * 400;
+  return bytes;
+}
+
+std::string Gigabytes(uint64_t bytes) {
+  std::ostringstream out;
+  out.precision(3);
+  out << static_cast<double>(bytes) / 1e9 << " GB";
+  return out.str();
+}
+
+}  // namespace
+
+uint64_t EstimateMonteCarloMemoryBytes(const MonteCarloSpec& spec) {
+  const TrajectoryGenerator generator(spec.simulation.motion, spec.simulation.rate_hz);
+  return MemoryOfPlan(spec, PlanJob(spec, generator), generator.rate_hz());
+}
+
+void ValidateMonteCarloSpec(const MonteCarloSpec& spec) {
+  ValidateSpec(spec);
+  if (spec.sensor) ValidateImuErrorModel(*spec.sensor, "sensor");
+  const TrajectoryGenerator generator(spec.simulation.motion, spec.simulation.rate_hz);
+  const JobPlan plan = PlanJob(spec, generator);
+  const uint64_t runs = spec.run_count == 0 ? spec.runs - spec.first_run : spec.run_count;
+  size_t checkpoints = 0;
+  for (const Report& r : plan.reports) checkpoints += r.checkpoint >= 0;
+  if (runs * checkpoints > uint64_t{kMaxMonteCarloRuns} * 10) {
+    throw SpecError("monte_carlo.checkpoint_times_s", std::to_string(checkpoints) + " checkpoints",
+                    "runs x checkpoints <= " + std::to_string(uint64_t{kMaxMonteCarloRuns} * 10));
+  }
+  const uint64_t bytes = MemoryOfPlan(spec, plan, generator.rate_hz());
+  if (spec.max_memory_bytes > 0 && bytes > spec.max_memory_bytes) {
+    throw LimitError("monte_carlo",
+                     "the job needs about " + Gigabytes(bytes) + " of memory (" +
+                         std::to_string(plan.n + 1) +
+                         " IMU samples of shared truth, runs x checkpoints of kept values); "
+                         "allowed: at most " +
+                         Gigabytes(spec.max_memory_bytes) +
+                         " (raise the limit with driftlab run --max-memory-gb or the server's "
+                         "--max-job-memory-gb; or shorten the motion, lower rate_hz, split runs "
+                         "into shards)",
+                     0);
+  }
+}
+
+namespace {
+
+// Generates the truth once and keeps what the runs need (without keep_imu: only the layout, the
+// reports and the start state, for ReplayMonteCarloRun). `cancel` is polled while the trajectory
+// streams (every 4096 samples); when it is set the function returns early with `cancelled`.
+SharedTruth BuildSharedTruth(const MonteCarloSpec& spec, bool keep_imu = true,
+                             const std::atomic<bool>* cancel = nullptr, bool* cancelled = nullptr) {
+  TrajectoryGenerator generator(spec.simulation.motion, spec.simulation.rate_hz);
+  SharedTruth s;
+  s.env = generator.environment();
+  s.dt_s = generator.dt_s();
+  s.rate_hz = generator.rate_hz();
+  s.truth0 = generator.initial_state();
+  const bool seed000 = spec.simulation.mechanization == MechanizationKind::kSeed000;
+  JobPlan plan = PlanJob(spec, generator);
+  s.n = plan.n;
+  s.start_step = plan.start_step;
+  s.reports = std::move(plan.reports);
+
   const AidingSpec& aiding = spec.aiding;
   if (keep_imu && aiding.gnss) {
     s.gnss_decimation = AidingDecimation(aiding.gnss->rate_hz, s.rate_hz, "aiding.gnss.rate_hz");
@@ -422,6 +525,10 @@ SharedTruth BuildSharedTruth(const MonteCarloSpec& spec, bool keep_imu = true) {
   TrajectorySample sample;
   while (generator.Next(&sample)) {
     const int64_t k = generator.step();
+    if (cancel != nullptr && (k & 4095) == 0 && cancel->load(std::memory_order_relaxed)) {
+      if (cancelled != nullptr) *cancelled = true;
+      return s;
+    }
     const size_t uk = static_cast<size_t>(k);
     if (keep_imu && point_samples) {
       s.samples[uk] = sample.sample;
@@ -920,11 +1027,22 @@ MonteCarloOutput RunMonteCarloWithAnalysis(
     const MonteCarloSpec& spec, const std::function<void(const MonteCarloProgress&)>& progress,
     const std::atomic<bool>* cancel) {
   const Clock::time_point start = Clock::now();
-  ValidateSpec(spec);
-  if (spec.sensor) ValidateImuErrorModel(*spec.sensor, "sensor");
+  ValidateMonteCarloSpec(spec);
   const uint32_t run_count = spec.run_count == 0 ? spec.runs - spec.first_run : spec.run_count;
 
-  SharedTruth shared = BuildSharedTruth(spec);
+  bool cancelled_early = false;
+  SharedTruth shared = BuildSharedTruth(spec, true, cancel, &cancelled_early);
+  if (cancelled_early) {
+    MonteCarloOutput output;
+    MonteCarloStatisticsData data;
+    data.seed = spec.seed;
+    data.job_runs = spec.runs;
+    data.cancelled = true;
+    data.timings.truth_s = Seconds(start);
+    data.timings.wall_s = data.timings.truth_s;
+    output.statistics = MonteCarloStatistics(std::move(data));
+    return output;
+  }
   const bool ekf = spec.filter == NavigationFilterKind::kInsGnssEkf;
   const bool complementary = spec.filter == NavigationFilterKind::kComplementary;
   // The error-state model of the sensor (no sensor: no process noise, no bias uncertainty).

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "driftlab/input_files.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::server {
@@ -39,11 +40,11 @@ std::string Sha256Hex(std::string_view text) {
 }
 
 TokenAuthenticator TokenAuthenticator::FromFile(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw SpecError(path.string(), "cannot read the tokens file", 0);
+  std::ifstream in = OpenInputFile(path, kMaxSmallTextFileBytes, path.string());
   std::vector<Entry> entries;
   std::string line;
-  for (int line_number = 1; std::getline(in, line); ++line_number) {
+  for (int line_number = 1; ReadLine(in, &line, path.string() + ":" + std::to_string(line_number));
+       ++line_number) {
     std::istringstream fields(line);
     std::string owner, hash, extra;
     if (!(fields >> owner) || owner[0] == '#') continue;

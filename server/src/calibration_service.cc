@@ -40,6 +40,29 @@ grpc::Status SettingsError(const SpecError& e, const google::protobuf::Descripto
   return InvalidArgument(e);
 }
 
+// The streamed table's column names: as many, as long and as distinct as a CSV header may be
+// (calibration_job.h: kMaxCsvColumns, kMaxCsvColumnNameBytes, no repeated name).
+void CheckColumnNames(const google::protobuf::RepeatedPtrField<std::string>& names) {
+  if (static_cast<size_t>(names.size()) > jobspec::kMaxCsvColumns) {
+    throw SpecError("settings.columns", fmt::format("{} columns", names.size()),
+                    fmt::format("at most {} columns", jobspec::kMaxCsvColumns));
+  }
+  for (int i = 0; i < names.size(); ++i) {
+    if (names[i].size() > jobspec::kMaxCsvColumnNameBytes) {
+      throw SpecError(fmt::format("settings.columns[{}]", i),
+                      fmt::format("{} bytes", names[i].size()),
+                      fmt::format("at most {} bytes", jobspec::kMaxCsvColumnNameBytes));
+    }
+    for (int j = 0; j < i; ++j) {
+      if (names[i] == names[j]) {
+        throw SpecError(fmt::format("settings.columns[{}]", i),
+                        "'" + names[i] + fmt::format("' (also columns[{}])", j),
+                        "distinct column names");
+      }
+    }
+  }
+}
+
 // Reads the settings message and then the rows of a client stream into `table`. `Request` is
 // CalibrateRequest or FitNoiseModelRequest (oneof payload {settings, rows}). Returns OK or the
 // status to answer with; `settings` holds the first message's settings.
@@ -64,6 +87,7 @@ grpc::Status ReadStream(grpc::ServerReader<Request>* reader, const ServerLimits&
       if (columns == 0) {
         throw SpecError("settings.columns", "", "the column names of the rows (at least one)");
       }
+      CheckColumnNames(settings->columns());
     } else if (request.has_rows()) {
       if (!have_settings) {
         throw SpecError("settings", fmt::format("missing before the rows of message {}", message),
@@ -83,11 +107,14 @@ grpc::Status ReadStream(grpc::ServerReader<Request>* reader, const ServerLimits&
                                       static_cast<size_t>(i) % columns));
         }
       }
-      const uint64_t rows = (table->values.size() + static_cast<size_t>(values.size())) / columns;
-      if (rows > limits.max_job_samples) {
-        return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
-                            fmt::format("rows: more than {} rows (the server's --max-job-samples)",
-                                        limits.max_job_samples));
+      // Bounded before the values are kept: the upload's memory is at most 8 x max_upload_values.
+      const uint64_t total = table->values.size() + static_cast<uint64_t>(values.size());
+      if (total > limits.max_upload_values) {
+        return grpc::Status(
+            grpc::StatusCode::RESOURCE_EXHAUSTED,
+            fmt::format("rows: more than {} values (rows x {} columns) in one upload; the "
+                        "server's limit is {} (--max-upload-values)",
+                        limits.max_upload_values, columns, limits.max_upload_values));
       }
       table->values.insert(table->values.end(), values.begin(), values.end());
       ++rows_message;

@@ -137,7 +137,8 @@ std::string SerializeDeterministic(const Message& message) {
   return bytes;
 }
 
-ValidatedJob ValidateSubmitRequest(const v1::SubmitJobRequest& request, int threads_per_job) {
+ValidatedJob ValidateSubmitRequest(const v1::SubmitJobRequest& request, int threads_per_job,
+                                   uint64_t max_memory_bytes) {
   if (!request.has_job()) throw SpecError("job", "", "a job (motion, rate_hz, navigation, ...)");
   CheckMessageValues(request.job());
   const v1::Motion& motion = request.job().motion();
@@ -177,6 +178,7 @@ ValidatedJob ValidateSubmitRequest(const v1::SubmitJobRequest& request, int thre
     }
   }
   overrides.threads = threads_per_job;
+  overrides.max_memory_bytes = max_memory_bytes;
 
   jobspec::JobFile file{request.job(), std::filesystem::path()};
   ValidatedJob out;
@@ -297,7 +299,10 @@ grpc::Status JobManager::Submit(const std::string& owner, const v1::SubmitJobReq
                                 v1::JobStatus* status) {
   ValidatedJob job;
   try {
-    job = ValidateSubmitRequest(request, threads_per_job_);
+    job = ValidateSubmitRequest(request, threads_per_job_, limits_.max_job_memory_bytes);
+  } catch (const LimitError& e) {
+    spdlog::info("submit rejected: owner={} error=\"{}\"", owner, e.what());
+    return grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED, e.what());
   } catch (const SpecError& e) {
     spdlog::info("submit rejected: owner={} error=\"{}\"", owner, e.what());
     return InvalidArgument(e);
@@ -335,8 +340,9 @@ grpc::Status JobManager::Submit(const std::string& owner, const v1::SubmitJobReq
   ++queued;
   live_[row.id] = live;
   queue_.push_back(row.id);
+  // The name is the user's text: escaped and bounded like every echoed input (MessageText).
   spdlog::info("job={} owner={} state=QUEUED runs={} samples={} name=\"{}\"", row.id, owner,
-               row.runs_total, row.samples_total, row.name);
+               row.runs_total, row.samples_total, MessageText(row.name, kMaxMessageValueBytes));
   *status = LiveStatus(*live);
   changed_.notify_all();
   return grpc::Status::OK;
@@ -584,7 +590,8 @@ void JobManager::RunJob(const std::shared_ptr<LiveJob>& live) {
     if (!request.ParseFromString(live->row.request)) {
       throw std::runtime_error("the stored request cannot be parsed");
     }
-    const ValidatedJob job = ValidateSubmitRequest(request, threads_per_job_);
+    const ValidatedJob job =
+        ValidateSubmitRequest(request, threads_per_job_, /*max_memory_bytes=*/0);
     // As `driftlab run`: the Monte-Carlo with the job's analyses (covariance, filter consistency).
     output = RunMonteCarloWithAnalysis(
         job.spec,
@@ -610,7 +617,7 @@ void JobManager::RunJob(const std::shared_ptr<LiveJob>& live) {
   } catch (const SpecError& e) {
     error = e.what();
   } catch (const std::exception& e) {
-    error = std::string("internal error: ") + e.what();
+    error = std::string("internal error: ") + MessageText(e.what(), kMaxMessageTextBytes);
   }
   if (requeue) {
     store_->Requeue(id);

@@ -63,6 +63,15 @@ int main(int argc, char** argv) {
                  "Largest job: runs x IMU samples per run")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  double max_job_memory_gb = static_cast<double>(options.limits.max_job_memory_bytes) / 1e9;
+  app.add_option("--max-job-memory-gb", max_job_memory_gb,
+                 "Largest job by its memory estimate [GB] (0 = no limit)")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
+  app.add_option("--max-upload-values", options.limits.max_upload_values,
+                 "Largest Calibrate / FitNoiseModel upload: rows x columns")
+      ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 40))
+      ->capture_default_str();
   app.add_option("--threads-per-job", options.limits.threads_per_job,
                  "Threads of one job (0 = hardware threads / max-concurrent-jobs)")
       ->check(CLI::Range(0, 1024))
@@ -80,6 +89,7 @@ int main(int argc, char** argv) {
   CLI::App* hash = app.add_subcommand("hash-token", "Print the SHA-256 of TOKEN for a tokens file");
   hash->add_option("token", token, "The bearer token")->required();
   CLI11_PARSE(app, argc, argv);
+  options.limits.max_job_memory_bytes = static_cast<uint64_t>(max_job_memory_gb * 1e9);
 
   if (hash->parsed()) {
     fmt::print("{}\n", driftlab::server::Sha256Hex(token));

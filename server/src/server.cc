@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "driftlab/input_files.h"
 #include "driftlab/server/data_services.h"
 #include "driftlab/server/jobs_service.h"
 #include "driftlab/spec_error.h"
@@ -16,11 +17,9 @@ namespace driftlab::server {
 namespace {
 
 std::string ReadPem(const std::filesystem::path& path, const std::string& option) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in || text.str().empty()) throw SpecError(option, path.string(), "a readable PEM file");
-  return text.str();
+  std::string text = ReadInputFile(path, kMaxSmallTextFileBytes, option);
+  if (text.empty()) throw SpecError(option, path.string(), "a PEM file (it is empty)");
+  return text;
 }
 
 }  // namespace

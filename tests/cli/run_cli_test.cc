@@ -106,6 +106,11 @@ TEST(Run, BadCommandLinesAndJobsNameTheField) {
        "monte_carlo.epoch_times_s[1]"},
       {{"run", (kData / "mc_bad_runs.json").string(), "--out", out},
        "monte_carlo.runs: 0 is not allowed"},
+      // The job's memory (2401 IMU increments of 48 bytes alone: 115 kB) over a 1 kB limit:
+      // refused before the truth is generated, naming the option that raises the limit.
+      {{"run", job, "--out", out, "--max-memory-gb", "0.000001"},
+       "raise the limit with driftlab run --max-memory-gb"},
+      {{"run", job, "--out", out, "--max-memory-gb", "-1"}, "--max-memory-gb: -1 is not allowed"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.args[c.args.size() - 1]);

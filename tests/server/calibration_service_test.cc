@@ -243,10 +243,10 @@ TEST_F(CalibrationServiceTest, MalformedStreamsAreInvalidArgumentNamingTheField)
   EXPECT_EQ(status.error_message().rfind("settings.rate_hz: -1", 0), 0u) << status.error_message();
 }
 
-TEST_F(CalibrationServiceTest, StreamBeyondTheSampleLimitIsResourceExhausted) {
+TEST_F(CalibrationServiceTest, StreamBeyondTheUploadValueLimitIsResourceExhausted) {
   TestAuthenticator accept(true);
   server::ServerLimits limits;
-  limits.max_job_samples = 2;
+  limits.max_upload_values = 12;  // two rows of the 6-column reference table
   auto service = server::MakeCalibrationService(&accept, limits);
   InProcessServer server({service.get()});
   auto stub = v1::Calibration::NewStub(server.channel());
@@ -254,7 +254,7 @@ TEST_F(CalibrationServiceTest, StreamBeyondTheSampleLimitIsResourceExhausted) {
   v1::CalibrationResult result;
   auto writer = stub->Calibrate(&context, &result);
   writer->Write(Settings(ReferenceSettings()));
-  writer->Write(Rows(kReferenceRows, 0, 18));  // 3 rows > 2
+  writer->Write(Rows(kReferenceRows, 0, 18));  // 3 rows = 18 values > 12
   writer->WritesDone();
   EXPECT_EQ(writer->Finish().error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
 }

@@ -316,6 +316,19 @@ TEST_F(JobsServiceTest, MalformedSubmitIsInvalidArgumentNamingTheField) {
     v1::JobStatus status;
     EXPECT_EQ(client_.Submit(request, &status).error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
   }
+  // Issue 15: a valid job whose memory (1 run x 100 000 s at 2000 Hz: 2e8 IMU increments of 48
+  // bytes, >= 9.6 GB) exceeds the server's --max-job-memory-gb (default 8 GB) is refused at
+  // Submit with RESOURCE_EXHAUSTED naming the limit, before anything is allocated; it used to be
+  // admitted (2e8 samples is under --max-job-samples) and end in std::bad_alloc.
+  {
+    v1::SubmitJobRequest request = Request(StaticJob(100000.0, 1, 7, 2000.0));
+    request.mutable_job()->mutable_monte_carlo()->set_epoch_interval_s(10.0);  // 10 001 epochs
+    v1::JobStatus status;
+    const grpc::Status s = client_.Submit(request, &status);
+    EXPECT_EQ(s.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << s.error_message();
+    EXPECT_NE(s.error_message().find("--max-job-memory-gb"), std::string::npos)
+        << s.error_message();
+  }
   // The server is still up and runs the next (valid) job.
   v1::JobStatus status;
   ASSERT_TRUE(client_.Submit(valid, &status).ok());

@@ -274,7 +274,21 @@ void CheckSettings(const CalibrateSettings& s) {
   }
   if (s.kind == "reference") {
     if (s.input_unit.empty()) throw SpecError("input_unit", "", "a unit name, e.g. deg/s or g");
-    if (s.output_unit.empty()) throw SpecError("output_unit", "", "a unit name, e.g. V or counts");
+    // The known inputs are rates or accelerations, in a unit the units module knows.
+    const Unit input = ParseUnit(s.input_unit, "input_unit");
+    if (input.dimension != dims::kAngularRate && input.dimension != dims::kAcceleration) {
+      throw SpecError("input_unit",
+                      "'" + s.input_unit + "' (" + DimensionName(input.dimension) + ")",
+                      "a unit of angular rate (deg/s, rad/s, ...) or acceleration (g, m/s^2, ...)");
+    }
+    // The raw outputs are in the sensor's own unit (V, counts, LSB): a short printable name.
+    const bool printable = std::all_of(s.output_unit.begin(), s.output_unit.end(), [](char c) {
+      return static_cast<unsigned char>(c) >= 0x20 && static_cast<unsigned char>(c) < 0x7F;
+    });
+    if (s.output_unit.empty() || s.output_unit.size() > 32 || !printable) {
+      throw SpecError("output_unit", s.output_unit.empty() ? "" : "'" + s.output_unit + "'",
+                      "a unit name of 1 to 32 printable ASCII characters, e.g. V or counts");
+    }
   }
 }
 

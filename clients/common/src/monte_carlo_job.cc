@@ -527,6 +527,8 @@ MonteCarloSpec ToMonteCarloSpec(const JobFile& file, const MonteCarloOverrides& 
           Closed(0.0, 1.0e7, "s"));
   }
   TranslateFilterAndAiding(file.job, overrides, &spec);
+  if (overrides.max_memory_bytes) spec.max_memory_bytes = *overrides.max_memory_bytes;
+  ValidateMonteCarloSpec(spec);
   return spec;
 }
 

@@ -260,4 +260,41 @@ void CheckJsonAgainstDescriptor(const Value& value, const Descriptor& descriptor
   CheckMessage(value, descriptor, path);
 }
 
+void CheckFieldSizes(const google::protobuf::Message& message, const std::string& path) {
+  using google::protobuf::FieldDescriptor;
+  const google::protobuf::Reflection& r = *message.GetReflection();
+  std::vector<const FieldDescriptor*> fields;
+  r.ListFields(message, &fields);
+  for (const FieldDescriptor* field : fields) {
+    const std::string name = path.empty() ? field->name() : path + "." + field->name();
+    const int count = field->is_repeated() ? r.FieldSize(message, field) : 1;
+    if (field->is_repeated() && count > kMaxJobRepeatedFieldSize) {
+      throw SpecError(name, std::to_string(count) + " entries",
+                      "at most " + std::to_string(kMaxJobRepeatedFieldSize) + " entries");
+    }
+    if (field->cpp_type() == FieldDescriptor::CPPTYPE_STRING) {
+      const size_t limit =
+          path.empty() && field->name() == "name" ? kMaxJobNameBytes : kMaxJobStringBytes;
+      for (int i = 0; i < count; ++i) {
+        std::string scratch;
+        const std::string& value = field->is_repeated()
+                                       ? r.GetRepeatedStringReference(message, field, i, &scratch)
+                                       : r.GetStringReference(message, field, &scratch);
+        if (value.size() > limit) {
+          throw SpecError(field->is_repeated() ? name + "[" + std::to_string(i) + "]" : name,
+                          std::to_string(value.size()) + " bytes",
+                          "at most " + std::to_string(limit) + " bytes");
+        }
+      }
+    } else if (field->cpp_type() == FieldDescriptor::CPPTYPE_MESSAGE) {
+      for (int i = 0; i < count; ++i) {
+        const google::protobuf::Message& child = field->is_repeated()
+                                                     ? r.GetRepeatedMessage(message, field, i)
+                                                     : r.GetMessage(message, field);
+        CheckFieldSizes(child, field->is_repeated() ? name + "[" + std::to_string(i) + "]" : name);
+      }
+    }
+  }
+}
+
 }  // namespace driftlab::jobspec

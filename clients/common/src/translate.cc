@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "driftlab/io.h"
+#include "driftlab/jobspec/schema_check.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/trajectory.h"
 #include "field_checks.h"
@@ -370,6 +371,7 @@ SimulationSpec ToSimulationSpec(const v1::Job& job, const std::filesystem::path&
 }
 
 SimulationSpec ValidateJob(const JobFile& file) {
+  CheckFieldSizes(file.job);
   SimulationSpec spec = ToSimulationSpec(file.job, file.base_dir);
   TrajectoryGenerator planned(spec.motion, spec.rate_hz);
   if (spec.mechanization == MechanizationKind::kSeed000) {

@@ -87,6 +87,11 @@ enum class NavigationFilterKind {
   kComplementary,
 };
 
+// Default memory limit of one job: 8 GB (a 1-run, 100 000 s job at 2000 Hz would need ~9.6 GB
+// of shared truth). Raised with `driftlab run --max-memory-gb` or the server's
+// --max-job-memory-gb.
+inline constexpr uint64_t kDefaultMaxJobMemoryBytes = 8'000'000'000ull;
+
 struct MonteCarloSpec {
   SimulationSpec simulation;            // motion, IMU rate, mechanization A or B and its options
   std::optional<ImuErrorModel> sensor;  // absent = error-free IMU (only initial errors act)
@@ -126,6 +131,9 @@ struct MonteCarloSpec {
   // VerticalChannel::kFree and filter kNone or kInsGnssEkf.
   bool covariance = false;
   int64_t covariance_step_samples = 10;  // propagation interval [IMU samples], 1 to 10000
+
+  // Largest memory the job may need (EstimateMonteCarloMemoryBytes) [bytes]; 0 = no limit.
+  uint64_t max_memory_bytes = kDefaultMaxJobMemoryBytes;
 };
 
 // Filter consistency of a kInsGnssEkf job: per output epoch, the exact sum over runs of the NEES
@@ -185,9 +193,10 @@ struct MonteCarloProgress {
 // thread. It must be thread-safe with respect to the caller's own data; an exception it throws
 // propagates out of RunMonteCarlo.
 //
-// cancel (optional): polled every 1024 samples of every run and before each run starts. Once set,
-// the workers stop within ~1024 samples and the function returns statistics with cancelled() ==
-// true and no runs, epochs or checkpoint values (timings are filled in).
+// cancel (optional): polled while the truth is generated (every 4096 samples), every 1024 samples
+// of every run and before each run starts. Once set, the workers stop within ~1024 samples and the
+// function returns statistics with cancelled() == true and no runs, epochs or checkpoint values
+// (timings are filled in).
 MonteCarloStatistics RunMonteCarlo(
     const MonteCarloSpec& spec,
     const std::function<void(const MonteCarloProgress&)>& progress = nullptr,
@@ -237,6 +246,19 @@ bool ReplayMonteCarloRun(const MonteCarloSpec& spec, uint32_t run, bool navigate
                          const std::function<void(const MonteCarloRunLayout&)>& on_start,
                          const std::function<void(const MonteCarloRunStep&)>& on_step,
                          const std::atomic<bool>* cancel = nullptr);
+
+// Every check RunMonteCarlo makes before it starts, without generating the trajectory (cost
+// O(segments + epochs)): the Monte-Carlo fields, the sensor model, the navigation start, the
+// alignment window, the epochs and checkpoints against the trajectory, the aiding against the rate
+// and duration, and the memory estimate against spec.max_memory_bytes. `driftlab validate`,
+// `driftlab run` and the server's Submit call it (through jobspec::ToMonteCarloSpec), so a job
+// that validates runs. Throws SpecError.
+void ValidateMonteCarloSpec(const MonteCarloSpec& spec);
+
+// The memory a job needs [bytes], approximately and from above: the shared truth (one IMU
+// increment or sample per output step, truth height when aided), the aiding truth, the per-run
+// values at the checkpoints (engine and result), the per-thread and result epoch statistics.
+uint64_t EstimateMonteCarloMemoryBytes(const MonteCarloSpec& spec);
 
 // The checks of the filter, aiding and covariance fields that need no trajectory (RunMonteCarlo
 // makes them too; exposed so that a job can be rejected before it is queued). Throws SpecError.

@@ -46,4 +46,12 @@ class SpecError : public std::runtime_error {
   std::string field_;
 };
 
+// A valid input that exceeds a resource limit (memory, size): reported like a SpecError (exit 2 in
+// the CLI) but as RESOURCE_EXHAUSTED by the server, and the message names the limit and how to
+// raise it.
+class LimitError : public SpecError {
+ public:
+  using SpecError::SpecError;
+};
+
 }  // namespace driftlab

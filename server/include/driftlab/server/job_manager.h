@@ -50,7 +50,8 @@ struct ValidatedJob {
 // server does not read files), runs in [1, 1000000], shard "i/K", deadline_s >= 0. Field paths
 // are those of the job file (e.g. "motion.segments[0].static.duration_s") and, for the request's
 // own fields, "runs", "seed", "shard", "deadline_s". Throws SpecError.
-ValidatedJob ValidateSubmitRequest(const v1::SubmitJobRequest& request, int threads_per_job);
+ValidatedJob ValidateSubmitRequest(const v1::SubmitJobRequest& request, int threads_per_job,
+                                   uint64_t max_memory_bytes = kDefaultMaxJobMemoryBytes);
 
 // Throws SpecError for the first enum field holding a value its enum does not define, the first
 // non-finite double or float field, or the first unknown field, with its field path under `path`.

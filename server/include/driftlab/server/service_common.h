@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <string>
 
+#include "driftlab/monte_carlo.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::server {
@@ -20,6 +21,11 @@ struct ServerLimits {
   uint64_t max_job_samples = 2'000'000'000;  // runs x IMU samples of one job (or one export run)
   int max_message_bytes = 64 << 20;          // largest request message
   int threads_per_job = 0;  // TBB arena size; 0 = hardware threads / max_concurrent_jobs
+  // Memory one job may need (EstimateMonteCarloMemoryBytes); over it Submit answers
+  // RESOURCE_EXHAUSTED naming --max-job-memory-gb. 0 = no limit.
+  uint64_t max_job_memory_bytes = kDefaultMaxJobMemoryBytes;
+  // Values (rows x columns) one Calibrate or FitNoiseModel call may upload: 50 M doubles = 400 MB.
+  uint64_t max_upload_values = 50'000'000;
 };
 
 // Bearer-token authentication (`authorization: Bearer <token>` metadata).

@@ -35,6 +35,9 @@ struct MonteCarloOverrides {
   std::optional<uint32_t> shard_count;
   // `run --covariance`: add the linear covariance analysis (as monte_carlo.covariance = true).
   bool covariance = false;
+  // `run --max-memory-gb` / the server's --max-job-memory-gb: the job's memory limit [bytes]
+  // (MonteCarloSpec::max_memory_bytes; default kDefaultMaxJobMemoryBytes, 0 = none).
+  std::optional<uint64_t> max_memory_bytes;
 };
 
 // Parses "i/K" (`--shard`); throws SpecError("--shard", text, "i/K with 0 <= i < K, K >= 1").
@@ -49,6 +52,9 @@ void ParseShard(const std::string& text, MonteCarloOverrides* overrides);
 // every number range-checked ("aiding.gnss.position_sigma_ned_m[2]"), outages ascending, not
 // overlapping and inside the trajectory ("aiding.gnss.outages[1].start_s" / ".end_s"), aiding
 // rates at most the IMU rate and dividing it, each aid only with the filter that uses it.
+// Ends with ValidateMonteCarloSpec (monte_carlo.h): every check RunMonteCarlo makes, including
+// those against the trajectory and the memory estimate, so that `validate`, `run` and the
+// server's Submit accept exactly the jobs that run.
 MonteCarloSpec ToMonteCarloSpec(const JobFile& file, const MonteCarloOverrides& overrides);
 
 // The job as run: the job file's message with the overrides written into monte_carlo (runs,

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <google/protobuf/descriptor.h>
+#include <google/protobuf/message.h>
 #include <google/protobuf/struct.pb.h>
 
 #include <string>
@@ -23,5 +24,15 @@ namespace driftlab::jobspec {
 void CheckJsonAgainstDescriptor(const google::protobuf::Value& value,
                                 const google::protobuf::Descriptor& descriptor,
                                 const std::string& path = "");
+
+// Size limits of a job's fields (issue 15), whatever way it arrives (file or gRPC request): every
+// string field at most kMaxJobStringBytes bytes (a job's `name` at most kMaxJobNameBytes), every
+// repeated field at most kMaxJobRepeatedFieldSize entries. Checked before any other work.
+inline constexpr size_t kMaxJobNameBytes = 256;
+inline constexpr size_t kMaxJobStringBytes = 4096;
+inline constexpr int kMaxJobRepeatedFieldSize = 100000;
+
+// Throws SpecError naming the first field over a limit above (path, its size, the limit).
+void CheckFieldSizes(const google::protobuf::Message& message, const std::string& path = "");
 
 }  // namespace driftlab::jobspec
