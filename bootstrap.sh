@@ -10,7 +10,7 @@ packages=(
   libyaml-cpp-dev libcli11-dev libfmt-dev libspdlog-dev libsqlite3-dev libssl-dev openssl
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-grpcio python3-protobuf python3-matplotlib python3-numpy
-  clang-format
+  clang-format ccache
 )
 
 missing=()

@@ -312,5 +312,30 @@ TEST(AllanTest, DenserGridHasDistinctIncreasingTaus) {
   EXPECT_LE(curve.back().m, (10000 - 1) / 2);
 }
 
+TEST(AllanTest, ValuesNearTheLargestDoubleGiveTheScaledDeviationNotInf) {
+  // Issue 15: values near 1e308 overflowed the sums and squares, and `allan` printed ADEV = inf.
+  // Power-of-two scaling is exact in binary floating point (no rounding without overflow or
+  // underflow), so the deviation of y * 2^1000 must be exactly 2^1000 times the deviation of y,
+  // bit for bit, at every tau: tolerance zero. y: the hand-computed series above, 1e6 offset
+  // (mean removal) and 1e307-scale values.
+  std::vector<double> y = {1.0, 2.0, 4.0, 7.0, 11.0, 3.0, 5.0, 8.0, 2.0};
+  for (auto& v : y) v += 1e6;
+  std::vector<double> huge = y;
+  for (auto& v : huge) v = std::ldexp(v, 1000);  // ~1.07e307
+  const auto curve = OverlappingAllanDeviation(y, 2.0, 1);
+  const auto curve_huge = OverlappingAllanDeviation(huge, 2.0, 1);
+  ASSERT_EQ(curve.size(), curve_huge.size());
+  for (size_t j = 0; j < curve.size(); ++j) {
+    EXPECT_TRUE(std::isfinite(curve_huge[j].adev_high));
+    EXPECT_EQ(curve_huge[j].adev, std::ldexp(curve[j].adev, 1000)) << "tau index " << j;
+    EXPECT_EQ(curve_huge[j].adev_low, std::ldexp(curve[j].adev_low, 1000));
+  }
+  // A deviation beyond the double range (alternating +-1e308: ADEV(tau0) = sqrt(2) 1e308) is
+  // refused, naming the samples, instead of printing inf.
+  std::vector<double> alternating(64);
+  for (size_t k = 0; k < alternating.size(); ++k) alternating[k] = k % 2 ? -1e308 : 1e308;
+  EXPECT_THROW(OverlappingAllanDeviation(alternating, 2.0, 1), SpecError);
+}
+
 }  // namespace
 }  // namespace driftlab

@@ -4,12 +4,22 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
+#include <span>
 #include <string>
 
 #include "driftlab/spec_error.h"
 
 namespace driftlab {
 namespace {
+
+// %g of a number, for messages.
+std::string G6(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
 
 // Integrated series x_i = sum_{k<i} (y_k - mean(y)), i = 0..n, in units of rate * sample.
 // Removing the mean first leaves every second difference unchanged (it annihilates a linear
@@ -257,9 +267,26 @@ std::vector<AllanPoint> OverlappingAllanDeviation(std::span<const double> rate_s
                       "finite numbers");
   }
 
+  // Values of huge magnitude (a corrupt recording, or ~1e308 on purpose) would overflow the
+  // squares of the second differences to inf (issue 15). Such data are scaled by a power of two
+  // first: power-of-two scaling is exact in binary floating point (IEEE 754: no rounding without
+  // overflow or underflow), so the scaled computation gives the same deviation, times the scale.
+  // Ordinary data (below 2^500 ~ 3e150) are not scaled and give bit-identical results.
+  double max_abs = 0.0;
+  for (const double v : rate_samples) max_abs = std::max(max_abs, std::abs(v));
+  double scale = 1.0;
+  std::vector<double> scaled;
+  std::span<const double> samples = rate_samples;
+  if (max_abs > 0x1p500) {
+    scale = std::ldexp(1.0, std::ilogb(max_abs) + 1);
+    scaled.resize(rate_samples.size());
+    for (size_t k = 0; k < rate_samples.size(); ++k) scaled[k] = rate_samples[k] / scale;
+    samples = scaled;
+  }
+
   const int64_t n = static_cast<int64_t>(rate_samples.size());
   const double tau0_s = 1.0 / rate_hz;
-  const std::vector<double> x = IntegratedSeries(rate_samples);
+  const std::vector<double> x = IntegratedSeries(samples);
   const std::vector<int64_t> ms = AveragingFactors(n, options.points_per_octave);
 
   std::vector<AllanPoint> curve(ms.size());
@@ -276,7 +303,7 @@ std::vector<AllanPoint> OverlappingAllanDeviation(std::span<const double> rate_s
     // x is in rate * sample units: AVAR = sum / (2 m^2 terms) in rate^2.
     const double avar = SecondDifferenceSumOfSquares(x, m) /
                         (2.0 * static_cast<double>(m) * static_cast<double>(m) * terms);
-    point.adev = std::sqrt(avar);
+    point.adev = std::sqrt(avar) * scale;
     if (options.noise_type == AllanNoiseType::kAuto) {
       identified[j] = IdentifyNoiseType(x, m, &point.noise_type) ? 1 : 0;
     } else {
@@ -306,6 +333,12 @@ std::vector<AllanPoint> OverlappingAllanDeviation(std::span<const double> rate_s
     point.edf = OverlappingAdevEdf(point.noise_type, n + 1, point.m);
     point.adev_low = point.adev * std::sqrt(point.edf / ChiSquareQuantile(p_high, point.edf));
     point.adev_high = point.adev * std::sqrt(point.edf / ChiSquareQuantile(p_low, point.edf));
+    if (!std::isfinite(point.adev_high))
+      throw SpecError("allan.samples",
+                      "values up to " + G6(max_abs) + " (Allan deviation at tau " +
+                          G6(point.tau_s) + " s beyond the range of double)",
+                      "samples whose Allan deviation and its confidence bound are below " +
+                          G6(std::numeric_limits<double>::max()));
   }
   return curve;
 }

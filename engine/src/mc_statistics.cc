@@ -229,7 +229,17 @@ void MonteCarloStatistics::Merge(const MonteCarloStatistics& other) {
   }
   d.timings.wall_s += o.timings.wall_s;
   d.timings.truth_s += o.timings.truth_s;
-  d.timings.samples_processed += o.timings.samples_processed;
+  // Sample counts come from result files too (merge): a hand-edited count must not overflow the
+  // signed sum (undefined behaviour, issue 15).
+  if (d.timings.samples_processed < 0 || o.timings.samples_processed < 0 ||
+      __builtin_add_overflow(d.timings.samples_processed, o.timings.samples_processed,
+                             &d.timings.samples_processed)) {
+    throw SpecError(
+        "timings.samples",
+        std::to_string(d.timings.samples_processed) + " + " +
+            std::to_string(o.timings.samples_processed),
+        "counts whose sum is at most " + std::to_string(std::numeric_limits<int64_t>::max()));
+  }
   d.timings.threads = std::max(d.timings.threads, o.timings.threads);
 }
 

@@ -1011,7 +1011,10 @@ void FilterConsistencyData::Merge(const FilterConsistencyData& other) {
   }
   for (size_t e = 0; e < nees_sum.size(); ++e) {
     nees_sum[e].Merge(other.nees_sum[e]);
-    nees_count[e] += other.nees_count[e];
+    if (__builtin_add_overflow(nees_count[e], other.nees_count[e], &nees_count[e])) {
+      throw SpecError("statistics.nees_counts[" + std::to_string(e) + "]", "a sum beyond 2^64",
+                      "counts of at most one per run");
+    }
   }
 }
 

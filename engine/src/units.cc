@@ -380,6 +380,12 @@ constexpr std::string_view kAllSymbols =
 // allowed units.
 Unit ParseUnitOrThrow(std::string_view unit, std::string_view text, std::string_view field_path,
                       std::string_view allowed) {
+  // A text too long to be a unit: say so first (an echo of it would be cut before the reason).
+  if (Trim(unit).size() > kMaxUnitTextBytes) {
+    throw SpecError(std::string(field_path),
+                    "a unit text of " + std::to_string(Trim(unit).size()) + " bytes",
+                    "a unit text of at most " + std::to_string(kMaxUnitTextBytes) + " bytes");
+  }
   try {
     const Term t = UnitParser(Trim(unit)).Parse();
     return Unit{t.factor, t.dim};

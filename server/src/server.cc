@@ -2,11 +2,14 @@
 
 #include <grpcpp/ext/proto_server_reflection_plugin.h>
 #include <grpcpp/health_check_service_interface.h>
+#include <grpcpp/support/server_interceptor.h>
 #include <signal.h>
 #include <spdlog/spdlog.h>
 
 #include <fstream>
+#include <memory>
 #include <sstream>
+#include <vector>
 
 #include "driftlab/input_files.h"
 #include "driftlab/server/data_services.h"
@@ -21,6 +24,44 @@ std::string ReadPem(const std::filesystem::path& path, const std::string& option
   if (text.empty()) throw SpecError(option, path.string(), "a PEM file (it is empty)");
   return text;
 }
+
+// gRPC's protobuf deserialization answers a request that is not a valid protobuf message with
+// INTERNAL and an empty message (grpcpp/impl/codegen/proto_utils.h: the message is
+// InitializationErrorString(), empty for proto3), before any service code runs (issue 15). That is
+// bad input, not a server fault: this interceptor turns exactly that status (INTERNAL, empty
+// message; driftlab's own INTERNAL errors always carry a message) into INVALID_ARGUMENT naming the
+// method.
+class MalformedRequestInterceptor : public grpc::experimental::Interceptor {
+ public:
+  explicit MalformedRequestInterceptor(grpc::experimental::ServerRpcInfo* info)
+      : method_(info->method() ? info->method() : "") {}
+
+  void Intercept(grpc::experimental::InterceptorBatchMethods* methods) override {
+    if (methods->QueryInterceptionHookPoint(
+            grpc::experimental::InterceptionHookPoints::PRE_SEND_STATUS)) {
+      const grpc::Status status = methods->GetSendStatus();
+      if (status.error_code() == grpc::StatusCode::INTERNAL && status.error_message().empty()) {
+        methods->ModifySendStatus(grpc::Status(grpc::StatusCode::INVALID_ARGUMENT,
+                                               "request: not a valid protobuf message for " +
+                                                   MessageText(method_, 200) +
+                                                   " (it could not be parsed)"));
+      }
+    }
+    methods->Proceed();
+  }
+
+ private:
+  std::string method_;
+};
+
+class MalformedRequestInterceptorFactory
+    : public grpc::experimental::ServerInterceptorFactoryInterface {
+ public:
+  grpc::experimental::Interceptor* CreateServerInterceptor(
+      grpc::experimental::ServerRpcInfo* info) override {
+    return new MalformedRequestInterceptor(info);
+  }
+};
 
 }  // namespace
 
@@ -92,6 +133,9 @@ Server::Server(const ServerOptions& options) : options_(options) {
   services_.push_back(MakeCalibrationService(&auth_, options.limits));
   services_.push_back(MakeDatasetsService(&auth_, options.limits));
   for (const auto& service : services_) builder.RegisterService(service.get());
+  std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> interceptors;
+  interceptors.push_back(std::make_unique<MalformedRequestInterceptorFactory>());
+  builder.experimental().SetInterceptorCreators(std::move(interceptors));
 
   manager_->Start();
   server_ = builder.BuildAndStart();

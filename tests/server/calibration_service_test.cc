@@ -203,6 +203,13 @@ TEST_F(CalibrationServiceTest, MalformedStreamsAreInvalidArgumentNamingTheField)
   negative_rate.set_rate_hz(-100.0);
   v1::CalibrateSettings unknown_kind = ReferenceSettings();
   unknown_kind.set_kind("magnetometer");
+  // Issue 15: unknown units, a unit of the wrong dimension and duplicate columns were accepted.
+  v1::CalibrateSettings unknown_unit = ReferenceSettings();
+  unknown_unit.set_input_unit("furlong/fortnight");
+  v1::CalibrateSettings wrong_dimension = ReferenceSettings();
+  wrong_dimension.set_input_unit("m");  // a length: neither a rate nor an acceleration
+  v1::CalibrateSettings duplicate_column = ReferenceSettings();
+  duplicate_column.set_columns(1, duplicate_column.columns(0));
   std::vector<double> with_nan = kReferenceRows;
   with_nan[4] = NAN;
   const std::vector<Case> cases = {
@@ -223,6 +230,15 @@ TEST_F(CalibrationServiceTest, MalformedStreamsAreInvalidArgumentNamingTheField)
        {Settings(unknown_kind), Rows(kReferenceRows, 0, 18)},
        "settings.kind"},
       {"no settings at all", {}, "settings: missing"},
+      {"unknown input unit",
+       {Settings(unknown_unit), Rows(kReferenceRows, 0, 18)},
+       "settings.input_unit"},
+      {"input unit of the wrong dimension",
+       {Settings(wrong_dimension), Rows(kReferenceRows, 0, 18)},
+       "settings.input_unit"},
+      {"duplicate column",
+       {Settings(duplicate_column), Rows(kReferenceRows, 0, 18)},
+       "settings.columns[1]"},
   };
   for (const Case& c : cases) {
     v1::CalibrationResult result;

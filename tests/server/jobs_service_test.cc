@@ -216,6 +216,31 @@ TEST_F(JobsServiceTest, HealthCheckAnswersServing) {
   EXPECT_EQ(bytes, std::string("\x08\x01", 2));
 }
 
+// Issue 15: bytes that are not a protobuf message were answered INTERNAL with an empty message
+// (gRPC's deserializer, before any driftlab code). Now INVALID_ARGUMENT naming the method; the
+// server then still answers the health check. 0xFF... is a tag with wire type 7, which does not
+// exist (protobuf encoding guide), so the bytes can never parse.
+TEST_F(JobsServiceTest, BytesThatAreNotAProtobufMessageAreInvalidArgument) {
+  grpc::GenericStub stub(
+      grpc::CreateChannel(server_.address(), grpc::InsecureChannelCredentials()));
+  auto call = [&stub](const std::string& method, const std::string& bytes) {
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + std::chrono::seconds(10));
+    const grpc::Slice slice(bytes);
+    const grpc::ByteBuffer request(&slice, 1);
+    grpc::ByteBuffer response;
+    std::promise<grpc::Status> done;
+    stub.UnaryCall(&context, method, grpc::StubOptions(), &request, &response,
+                   [&done](grpc::Status s) { done.set_value(s); });
+    return done.get_future().get();
+  };
+  const grpc::Status status = call("/driftlab.v1.Jobs/Submit", std::string(64, '\xff'));
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT) << status.error_message();
+  EXPECT_NE(status.error_message().find("/driftlab.v1.Jobs/Submit"), std::string::npos)
+      << status.error_message();
+  EXPECT_TRUE(call("/grpc.health.v1.Health/Check", "").ok());
+}
+
 // Malformed submissions: INVALID_ARGUMENT whose message names the field; the server then still
 // runs a valid job.
 TEST_F(JobsServiceTest, MalformedSubmitIsInvalidArgumentNamingTheField) {

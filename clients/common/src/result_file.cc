@@ -253,6 +253,23 @@ void ValidateJobResult(const v1::JobResult& result) {
   CheckNonNegative("timings.wall_s", timings.wall_s());
   if (timings.has_cpu_s()) CheckNonNegative("timings.cpu_s", timings.cpu_s());
   CheckNonNegative("timings.samples_per_s", timings.samples_per_s());
+  // Counts are summed when shards are merged (signed 64-bit in the engine): bounded here so that
+  // no hand-edited file can overflow them (issue 15). 2^62 samples is ~150 years at 1e9 samples/s.
+  constexpr uint64_t kMaxResultSamples = uint64_t{1} << 62;
+  if (timings.samples() > kMaxResultSamples) {
+    throw SpecError("timings.samples", std::to_string(timings.samples()),
+                    fmt::format("<= {} (2^62)", kMaxResultSamples));
+  }
+
+  const v1::MergeState& merge_counts = result.merge_state();
+  for (int i = 0; i < merge_counts.nees_counts_size(); ++i) {
+    // One NEES value per run and epoch at most.
+    if (merge_counts.nees_counts(i) > result.run_count()) {
+      throw SpecError(fmt::format("merge_state.nees_counts[{}]", i),
+                      std::to_string(merge_counts.nees_counts(i)),
+                      fmt::format("<= run_count = {} (one per run)", result.run_count()));
+    }
+  }
 
   const v1::MergeState& merge = result.merge_state();
   if (!merge.epochs().empty()) {

@@ -26,6 +26,12 @@ double NiceNumber(double x, bool round) {
 
 AxisTicks NiceTicks(double lo, double hi, int target) {
   if (!std::isfinite(lo) || !std::isfinite(hi)) lo = hi = 0;
+  // A valid result may hold values up to the largest double (issue 15: +-1e308 made the span, the
+  // step and the label precision overflow, and fmt aborted). Axes end at +-1e306, so the span, the
+  // step and every tick stay finite; larger values are drawn at the edge.
+  constexpr double kAxisLimit = 1e306;
+  lo = std::clamp(lo, -kAxisLimit, kAxisLimit);
+  hi = std::clamp(hi, -kAxisLimit, kAxisLimit);
   if (lo > hi) std::swap(lo, hi);
   if (hi - lo <= std::abs(hi) * 1e-12) {  // one value: give it a range around itself
     const double pad = hi != 0 ? std::abs(hi) * 0.1 : 1.0;
@@ -40,7 +46,8 @@ AxisTicks NiceTicks(double lo, double hi, int target) {
   const double last = std::ceil(hi / ticks.step);
   ticks.lo = first * ticks.step;
   ticks.hi = last * ticks.step;
-  ticks.decimals = std::max(0, -static_cast<int>(std::floor(std::log10(ticks.step))));
+  // Decimals of the step: 0 .. 17 (a double has at most 17 significant decimal digits).
+  ticks.decimals = std::clamp(-static_cast<int>(std::floor(std::log10(ticks.step))), 0, 17);
   for (double k = first; k <= last; k += 1) ticks.values.push_back(k * ticks.step);
   return ticks;
 }
@@ -62,6 +69,8 @@ double Chart::Axis::Map(double v) const { return scale == Scale::kLog10 ? std::l
 
 std::string Chart::Axis::Label(double tick) const {
   if (scale == Scale::kLog10) return fmt::format("{:g}", std::pow(10.0, tick));
+  // Fixed notation up to 1e9; beyond, the label would be tens to hundreds of digits wide.
+  if (std::abs(tick) >= 1e9) return fmt::format("{:.4g}", tick);
   return fmt::format("{:.{}f}", tick + 0.0, ticks.decimals);  // + 0.0: no "-0"
 }
 
