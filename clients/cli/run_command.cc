@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "driftlab/jobspec/consistency_check.h"
 #include "driftlab/jobspec/html_report.h"
 #include "driftlab/jobspec/job_file.h"
 #include "driftlab/jobspec/monte_carlo_job.h"
@@ -73,6 +74,19 @@ void PrintFinalSummary(const v1::JobResult& result) {
   const v1::Timings& t = result.timings();
   fmt::print("{} samples in {:.2f} s wall ({:.3g} samples/s, {} threads)\n", t.samples(),
              t.wall_s(), t.samples_per_s(), t.threads());
+  // Issue 18: say when the filter or the covariance analysis is wrong about its own uncertainty
+  // (a shard holds too few runs to judge: only whole results are tested).
+  if (result.run_count() == result.runs()) {
+    const jobspec::ConsistencyVerdict verdict = jobspec::AssessConsistency(result);
+    if (verdict.tested()) {
+      if (verdict.consistent()) {
+        fmt::print("consistency: {}\n", verdict.Summary());
+      } else {
+        std::fflush(stdout);
+        fmt::print(stderr, "warning: consistency: {}\n", verdict.Summary());
+      }
+    }
+  }
 }
 
 // Writes the result and the report; SpecError for I/O problems (named by the file).

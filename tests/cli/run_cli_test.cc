@@ -5,6 +5,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -34,8 +35,8 @@ TEST(Run, WritesAResultAndASelfContainedReport) {
   Scratch scratch;
   const fs::path result = scratch.dir() / "out" / "result.json";
   const fs::path report = scratch.dir() / "out" / "report.html";
-  const Result r = RunDriftlab({"run", (kData / "mc_small.json").string(), "--out",
-                                result.string(), "--report", report.string(), "--threads", "2"},
+  const Result r = RunDriftlab({"run", (kData / "mc_small.json").string(), "--out", result.string(),
+                                "--report", report.string(), "--threads", "2"},
                                scratch);
   ASSERT_EQ(r.exit_status, 0) << r.err;
   EXPECT_NE(r.out.find("mc_small: runs 0..39 of 40, seed 3"), std::string::npos) << r.out;
@@ -45,15 +46,48 @@ TEST(Run, WritesAResultAndASelfContainedReport) {
   const std::string json = ReadFile(result);
   EXPECT_NE(json.find("\"merge_state\""), std::string::npos);
   // Valid JSON that another tool reads: Python's json module parses it and finds 40 runs.
-  const std::string check = "/usr/bin/python3 -c \"import json,sys; r=json.load(open(sys.argv[1]));"
-                            " sys.exit(0 if r['runs']==40 and len(r['checkpoints'][-1]['runs'])==40"
-                            " else 1)\" " +
-                            result.string();
+  const std::string check =
+      "/usr/bin/python3 -c \"import json,sys; r=json.load(open(sys.argv[1]));"
+      " sys.exit(0 if r['runs']==40 and len(r['checkpoints'][-1]['runs'])==40"
+      " else 1)\" " +
+      result.string();
   EXPECT_EQ(std::system(check.c_str()), 0);
   const std::string html = ReadFile(report);
   EXPECT_NE(html.find("<svg"), std::string::npos);
   EXPECT_EQ(html.find("http://"), std::string::npos);
   EXPECT_EQ(html.find("https://"), std::string::npos);
+}
+
+TEST(Run, ConsistencyVerdictIsPrintedAndOnTheReportsFirstScreen) {
+  // Issue 18: with a covariance analysis (or a filter) the run says whether the Monte-Carlo
+  // spread agrees with the prediction: one line, on stdout when consistent, as a warning on
+  // stderr when not; the report shows the verdict before the summary table.
+  Scratch scratch;
+  const fs::path result = scratch.dir() / "result.json";
+  const fs::path report = scratch.dir() / "report.html";
+  // The covariance analysis needs the free vertical channel.
+  std::string text = ReadFile(kData / "mc_small.json");
+  text.replace(text.find("TRUTH_HEIGHT"), 12, "FREE");
+  const fs::path job = scratch.dir() / "mc_small_free.json";
+  std::ofstream(job) << text;
+  const Result r = RunDriftlab(
+      {"run", job.string(), "--covariance", "--out", result.string(), "--report", report.string()},
+      scratch);
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  const bool consistent =
+      r.out.find("consistency: consistent at family-wise level 0.05") != std::string::npos;
+  const bool warned = r.err.find("warning: consistency: INCONSISTENT at family-wise level 0.05") !=
+                      std::string::npos;
+  EXPECT_TRUE(consistent != warned) << r.out << r.err;
+  const std::string html = ReadFile(report);
+  const size_t verdict = html.find("Consistency: ");
+  ASSERT_NE(verdict, std::string::npos);
+  EXPECT_LT(verdict, html.find("<h2>Summary"));
+  // Without a prediction or a filter there is nothing to judge, and nothing is printed.
+  const Result plain =
+      RunDriftlab({"run", (kData / "mc_small.json").string(), "--out", result.string()}, scratch);
+  ASSERT_EQ(plain.exit_status, 0) << plain.err;
+  EXPECT_EQ((plain.out + plain.err).find("consistency:"), std::string::npos);
 }
 
 TEST(Run, FourShardsMergedEqualOneProcessAndThreadsDoNotMatter) {
@@ -83,9 +117,8 @@ TEST(Run, FourShardsMergedEqualOneProcessAndThreadsDoNotMatter) {
   EXPECT_TRUE(one == WithoutTimings(ReadFile(file("merged.json"))));
   // A shard alone is not the whole job, and two copies of one shard do not merge.
   EXPECT_FALSE(one == WithoutTimings(ReadFile(file("shard0.json"))));
-  const Result twice =
-      RunDriftlab({"merge", file("shard0.json"), file("shard0.json"), "--out", file("bad.json")},
-                  scratch);
+  const Result twice = RunDriftlab(
+      {"merge", file("shard0.json"), file("shard0.json"), "--out", file("bad.json")}, scratch);
   EXPECT_EQ(twice.exit_status, 2);
   EXPECT_FALSE(fs::exists(file("bad.json")));
 }
@@ -124,16 +157,16 @@ TEST(Run, BadCommandLinesAndJobsNameTheField) {
 TEST(Gate, ADegradedPresetFailsAgainstTheOriginalsBaselineAndTheOriginalPasses) {
   Scratch scratch;
   auto file = [&scratch](const std::string& name) { return (scratch.dir() / name).string(); };
-  ASSERT_EQ(RunDriftlab({"run", (kData / "mc_small.json").string(), "--out", file("base.json"),
-                         "-q"},
-                        scratch)
-                .exit_status,
-            0);
-  ASSERT_EQ(RunDriftlab({"run", (kData / "mc_small.json").string(), "--out", file("again.json"),
-                         "-q"},
-                        scratch)
-                .exit_status,
-            0);
+  ASSERT_EQ(
+      RunDriftlab({"run", (kData / "mc_small.json").string(), "--out", file("base.json"), "-q"},
+                  scratch)
+          .exit_status,
+      0);
+  ASSERT_EQ(
+      RunDriftlab({"run", (kData / "mc_small.json").string(), "--out", file("again.json"), "-q"},
+                  scratch)
+          .exit_status,
+      0);
   ASSERT_EQ(RunDriftlab({"run", (kData / "mc_small_degraded.json").string(), "--out",
                          file("degraded.json"), "-q"},
                         scratch)

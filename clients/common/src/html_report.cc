@@ -7,6 +7,7 @@
 #include <cmath>
 #include <utility>
 
+#include "driftlab/jobspec/consistency_check.h"
 #include "driftlab/jobspec/result_file.h"
 #include "svg_plot.h"
 
@@ -18,6 +19,7 @@ using svg::Figure;
 using svg::kStyle;
 using svg::Num;
 using svg::Range;
+using svg::Scale;
 
 // At most this many epochs are drawn per envelope (every k-th and the last; the statistics
 // tables use all), and this many runs in the scatter (the first by run index; the histograms use
@@ -81,8 +83,9 @@ std::string NeesPlot(const v1::JobResult& result) {
     for (const double v : {e.average_nees(), e.chi2_95_low(), e.chi2_95_high()}) y.Add(v);
   }
   if (nees.empty()) return "";
-  y.Add(0);
-  Chart chart(520, 230, x, y, "t [s]", "average NEES");
+  // Log axis (issue 18): an average NEES 40 times its band flattened the band to under a pixel on
+  // a linear axis.
+  Chart chart(520, 230, x, y, "t [s]", "average NEES (log)", Scale::kLinear, Scale::kLog10);
   chart.Band(upper, lower, kBandColor);
   chart.Polyline(nees, kMeanColor);
   return Figure(
@@ -90,6 +93,35 @@ std::string NeesPlot(const v1::JobResult& result) {
       fmt::format("average NEES of the {} navigation error states over the runs, with its "
                   "chi-square 95 % band (mean over epochs {})",
                   fc.state_dimension(), Num(fc.mean_average_nees())));
+}
+
+// The consistency verdict on the first screen (issue 18): whether the Monte-Carlo spread agrees
+// with the filter's covariance (NEES) and with the covariance analysis (sigma ratios).
+std::string ConsistencyBox(const v1::JobResult& result) {
+  const ConsistencyVerdict v = AssessConsistency(result);
+  if (!v.tested()) return "";
+  std::string html = fmt::format(
+      "<div class=\"verdict\" style=\"border:2px solid {0};padding:6px 10px;margin:8px 0\">"
+      "<b style=\"color:{0}\">Consistency: {1}</b><br/>{2}",
+      v.consistent() ? "#2a7d2a" : "#b00020", v.consistent() ? "consistent" : "INCONSISTENT",
+      EscapeHtml(v.Summary()));
+  if (!v.components.empty()) {
+    html += "<table><tr><th>component</th><th>MC &sigma; / predicted &sigma;</th><th>interval "
+            "(Bonferroni)</th><th></th></tr>\n";
+    for (const ComponentConsistency& c : v.components) {
+      html += fmt::format("<tr><td>{}</td><td class=\"num\">{:.3g}</td><td class=\"num\">[{:.3g}, "
+                          "{:.3g}]</td><td>{}</td></tr>\n",
+                          ConsistencyComponentName(c.component), c.ratio.ratio, c.ratio.low,
+                          c.ratio.high, c.flagged ? "&#9888; outside" : "ok");
+    }
+    html += "</table>";
+  }
+  html += fmt::format(
+      "<p style=\"font-size:90%\">Tests at family-wise false-alarm rate {:g} (Bonferroni over the "
+      "epochs and components tested): the N-run average NEES of a consistent filter is "
+      "&chi;&sup2;(dN)/N; (N&minus;1)s&sup2;/&sigma;&sup2; is &chi;&sup2;(N&minus;1).</p></div>\n",
+      v.alpha);
+  return html;
 }
 
 std::string EnvelopePlot(const v1::JobResult& result, int c) {
@@ -325,6 +357,7 @@ std::string RenderHtmlReport(const v1::JobResult& result) {
   html += "<h1>driftlab Monte-Carlo report: " + EscapeHtml(name) + "</h1>\n";
   if (!job.description().empty()) html += "<p>" + EscapeHtml(job.description()) + "</p>\n";
   html += RunTable(result);
+  html += ConsistencyBox(result);
 
   html += "<h2>Summary</h2>\n" + SummaryTable(result);
   for (int i = 0; i + 1 < result.checkpoints_size(); ++i) {
