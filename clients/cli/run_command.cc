@@ -37,6 +37,7 @@
 #include "progress.h"
 #include "remote.h"
 #include "run_output.h"
+#include "slurm_run.h"
 
 namespace driftlab::cli {
 namespace {
@@ -132,9 +133,39 @@ struct RunOptions {
   bool covariance = false;
   std::optional<double> max_memory_gb;
   RemoteOptions remote;
+  bool slurm = false;
+  uint32_t slurm_shards = 4;
+  std::optional<uint32_t> slurm_shards_option;
+  std::string slurm_partition;
+  std::string slurm_dir;
 };
 
 int RunRun(const RunOptions& options) {
+  if (options.slurm) {
+    const char* conflict = !options.remote.server.empty() ? "--server"
+                           : options.shard                ? "--shard"
+                           : options.threads              ? "--threads"
+                                                          : nullptr;
+    if (conflict != nullptr) {
+      fmt::print(stderr,
+                 "error: --slurm: given with {} is not allowed; allowed: --slurm alone (the tasks "
+                 "take the array's CPUs and shards)\n",
+                 conflict);
+      return kExitBadJob;
+    }
+    SlurmRunOptions slurm;
+    slurm.job_path = options.job_path;
+    slurm.out = options.out;
+    slurm.report = options.report;
+    slurm.runs = options.runs;
+    slurm.seed = options.seed;
+    slurm.covariance = options.covariance;
+    slurm.quiet = options.quiet;
+    slurm.shards = options.slurm_shards;
+    slurm.partition = options.slurm_partition;
+    slurm.work_dir = options.slurm_dir;
+    return RunOnSlurm(slurm);
+  }
   if (!options.remote.server.empty()) {
     if (options.threads) {
       fmt::print(stderr,
@@ -243,7 +274,26 @@ const RegisterCommand kRun("run", [](CLI::App& app) -> std::function<int()> {
       "--covariance", options->covariance,
       "Add the linear covariance analysis (predicted sigma of every error component)");
   AddRemoteOptions(command, &options->remote, /*server_required=*/false);
-  return [options] { return RunRun(*options); };
+  command->add_flag("--slurm", options->slurm,
+                    "Run the shards as a Slurm job array (sbatch), then merge them here");
+  AddUnsignedOption(command, "--shards", &options->slurm_shards_option,
+                    "With --slurm: array tasks, one shard each (default 4)");
+  command->add_option("--partition", options->slurm_partition,
+                      "With --slurm: the Slurm partition (default: the cluster's)");
+  command->add_option(
+      "--slurm-dir", options->slurm_dir,
+      "With --slurm: shared directory for the shards and logs (default RESULT.slurm)");
+  return [options] {
+    if (!options->slurm && (options->slurm_shards_option || !options->slurm_partition.empty() ||
+                            !options->slurm_dir.empty())) {
+      fmt::print(stderr,
+                 "error: --shards, --partition, --slurm-dir: given without --slurm is not "
+                 "allowed; allowed: with --slurm only\n");
+      return kExitBadJob;
+    }
+    if (options->slurm_shards_option) options->slurm_shards = *options->slurm_shards_option;
+    return RunRun(*options);
+  };
 });
 
 const RegisterCommand kMerge("merge", [](CLI::App& app) -> std::function<int()> {
