@@ -161,6 +161,25 @@ TEST(GateStatistics, PairedTestsHoldAlphaOnCorrelatedRuns) {
   EXPECT_NEAR(mean.covered, 1 - kAlpha, Slack(kAlpha));
 }
 
+TEST(GateStatistics, PairedBootstrapOfAQuantileRatio) {
+  // Identical runs: every resampled ratio is 1, so the interval is [1, 1] and p = 1; runs scaled
+  // by 1.5 against a limit of 1.1: every resampled ratio is 1.5, p = 1 / (B + 1), the smallest a
+  // bootstrap p can be.
+  std::mt19937_64 rng(71);
+  std::vector<double> x = Normal(rng, 200, 1.0);
+  for (double& v : x) v = std::abs(v);
+  const TestOutcome same = TestQuantilePaired(x, x, 0.95, 1.1, kAlpha);
+  EXPECT_EQ(same.ratio_low, 1.0);
+  EXPECT_EQ(same.ratio_high, 1.0);
+  EXPECT_EQ(same.p_value, 1.0);
+  std::vector<double> y = x;
+  for (double& v : y) v *= 1.5;
+  const TestOutcome scaled = TestQuantilePaired(x, y, 0.5, 1.1, kAlpha);
+  EXPECT_NEAR(scaled.ratio, 1.5, 1e-12);
+  EXPECT_EQ(scaled.p_value, 1.0 / (kBootstrapResamples + 1));
+  // Its rejection rate at the H0 boundary: gate_slow_lib_test.cc (it takes seconds).
+}
+
 TEST(GateStatistics, NeesTestHoldsAlphaForChiSquareAverages) {
   // Average NEES of N runs of a consistent 9-state filter: chi2(9 N) / N; the current filter's
   // NEES 1.1 x (the limit).

@@ -133,6 +133,11 @@ TestOutcome TestMetric(const v1::JobResult& baseline, const Metric& mb,
       none.test = "none: per-run values not kept";
       return none;
     }
+    if (paired && xb.size() == xc.size() && xb.size() >= 3) {
+      TestOutcome out = TestQuantilePaired(xb, xc, mb.quantile, limit_ratio, alpha);
+      out.ratio = mc.value / mb.value;
+      return out;
+    }
     TestOutcome out = TestQuantile(std::move(xb), std::move(xc), mb.quantile, limit_ratio, alpha);
     out.ratio = mc.value / mb.value;  // the files' own percentiles
     return out;

@@ -25,6 +25,9 @@
 //             (Pitman, Biometrika 31, 1939; Morgan, Biometrika 31, 1939)
 //   RMS       paired t on d_i = y_i^2 - rho^2 x_i^2 (t(n - 1), large-sample)
 //   |mean|    paired t on d_i = s_c y_i - rho s_b x_i, s = the sign of each sample mean
+//   quantile  paired bootstrap of the ratio of the two quantiles (runs resampled together, B =
+//             kBootstrapResamples, fixed seed): p = (1 + #{ratio* <= rho}) / (B + 1), percentile
+//             interval (Efron & Tibshirani, An Introduction to the Bootstrap, 1993, ch. 13, 16)
 #pragma once
 
 #include <string>
@@ -59,6 +62,10 @@ TestOutcome TestSigmaPaired(const std::vector<double>& x, const std::vector<doub
                             double limit_ratio, double alpha);
 TestOutcome TestRmsPaired(const std::vector<double>& x, const std::vector<double>& y,
                           double limit_ratio, double alpha);
+inline constexpr int kBootstrapResamples = 3999;
+// x, y: |error| of the runs, paired.
+TestOutcome TestQuantilePaired(const std::vector<double>& x, const std::vector<double>& y,
+                               double p, double limit_ratio, double alpha);
 TestOutcome TestAbsMeanPaired(const std::vector<double>& x, const std::vector<double>& y,
                               double limit_ratio, double alpha);
 
