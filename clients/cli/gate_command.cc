@@ -69,16 +69,18 @@ int PrintRunsForChange(const v1::JobResult& result, const std::vector<jobspec::G
   const long runs = jobspec::RunsForSigmaChange(1.0 + options.runs_for_change, rel_tol,
                                                 options.alpha, std::max(gated, 1));
   if (runs == 0) {
-    fmt::print("a sigma change of +{:g} % is within the {:g} % tolerance of {}: no run count "
-               "makes it a regression\n",
-               100.0 * options.runs_for_change, 100.0 * rel_tol, reference);
+    fmt::print(
+        "a sigma change of +{:g} % is within the {:g} % tolerance of {}: no run count "
+        "makes it a regression\n",
+        100.0 * options.runs_for_change, 100.0 * rel_tol, reference);
     return kExitOk;
   }
-  fmt::print("runs per file (baseline and current) for a sigma grown by {:g} % to be a "
-             "regression with 90 % power: {}\n(tolerance {:g} % from the rule of {}, alpha {} "
-             "family-wise over {} gated metrics, variance-ratio F test at alpha / {})\n",
-             100.0 * options.runs_for_change, runs, 100.0 * rel_tol, reference, options.alpha,
-             gated, gated);
+  fmt::print(
+      "runs per file (baseline and current) for a sigma grown by {:g} % to be a "
+      "regression with 90 % power: {}\n(tolerance {:g} % from the rule of {}, alpha {} "
+      "family-wise over {} gated metrics, variance-ratio F test at alpha / {})\n",
+      100.0 * options.runs_for_change, runs, 100.0 * rel_tol, reference, options.alpha, gated,
+      gated);
   return kExitOk;
 }
 
@@ -124,8 +126,7 @@ int RunGateCommand(const GateOptions& options) {
 const RegisterCommand kGate("gate", [](CLI::App& app) -> std::function<int()> {
   auto options = std::make_shared<GateOptions>();
   CLI::App* command = app.add_subcommand(
-      "gate",
-      "Test a result's metrics against a baseline: exit 0 pass, 1 regression, 2 bad input");
+      "gate", "Test a result's metrics against a baseline: exit 0 pass, 1 regression, 2 bad input");
   command->add_option("result", options->result_path, "Result file to check")->required();
   command->add_option("--baseline,-b", options->baseline_path, "Baseline result file");
   command->add_option("--rules,-r", options->rules_path,

@@ -17,8 +17,8 @@ TEST(GateDistributions, IncompleteGammaAndBetaMatchClosedForms) {
     EXPECT_NEAR(RegularizedGammaP(0.5, x), std::erf(std::sqrt(x)), 1e-12) << x;
   }
   for (const double x : {0.0, 0.1, 0.5, 0.9, 1.0}) {
-    EXPECT_NEAR(RegularizedBeta(1.0, 1.0, x), x, 1e-12);                    // uniform
-    EXPECT_NEAR(RegularizedBeta(3.0, 1.0, x), std::pow(x, 3), 1e-12);        // I_x(a, 1) = x^a
+    EXPECT_NEAR(RegularizedBeta(1.0, 1.0, x), x, 1e-12);               // uniform
+    EXPECT_NEAR(RegularizedBeta(3.0, 1.0, x), std::pow(x, 3), 1e-12);  // I_x(a, 1) = x^a
     EXPECT_NEAR(RegularizedBeta(2.5, 4.0, x), 1.0 - RegularizedBeta(4.0, 2.5, 1.0 - x), 1e-12);
   }
 }

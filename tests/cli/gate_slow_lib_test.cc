@@ -88,9 +88,10 @@ TEST(GateSlow, IndependentSeedsOfTheSameJobFailAtMostTenOfOneHundredGates) {
     metrics += static_cast<int>(report.rows.size());
     if (!report.passed()) std::printf("%s", FormatGateTable(report).c_str());
   }
-  std::printf("false alarms: %d of 100 gates failed (alpha 0.05); %d gates had inconclusive "
-              "metrics (%d of %d metrics); %.1f s\n",
-              failed, inconclusive_gates, inconclusive_metrics, metrics, Since(start));
+  std::printf(
+      "false alarms: %d of 100 gates failed (alpha 0.05); %d gates had inconclusive "
+      "metrics (%d of %d metrics); %.1f s\n",
+      failed, inconclusive_gates, inconclusive_metrics, metrics, Since(start));
   EXPECT_LE(failed, 10);
 }
 
@@ -110,9 +111,10 @@ TEST(GateSlow, GyroArwTimesOnePointThreeIsCaughtAtThePlannedRunCount) {
     const GateReport report = RunGate(baseline, degraded, DefaultGateRules(), Options(true));
     caught += report.passed() ? 0 : 1;
   }
-  std::printf("power: ARW x 1.3 caught in %d of 50 pairs at %ld runs per file (planning help, "
-              "%d gated metrics); %.1f s\n",
-              caught, runs, gated, Since(start));
+  std::printf(
+      "power: ARW x 1.3 caught in %d of 50 pairs at %ld runs per file (planning help, "
+      "%d gated metrics); %.1f s\n",
+      caught, runs, gated, Since(start));
   EXPECT_GE(caught, 45);
 }
 
@@ -120,10 +122,10 @@ TEST(GateSlow, PairedGateCatchesArwTimesOnePointZeroFiveAtTwoPercent) {
   const auto start = std::chrono::steady_clock::now();
   // Same seed and 200 runs: run r of both draws the same noise, so the current errors are 1.05
   // times the baseline's run by run and the paired tests see 1.05 against the limit 1.02.
-  const std::vector<GateRule> rules =
-      ParseGateRules("rules:\n  - {metric: 'final.*', rel_tol: 0.02}\n"
-                     "  - {metric: 'final.*.abs_mean', skip: true}\n"
-                     "  - {metric: 'final.*.p99', skip: true}\n");
+  const std::vector<GateRule> rules = ParseGateRules(
+      "rules:\n  - {metric: 'final.*', rel_tol: 0.02}\n"
+      "  - {metric: 'final.*.abs_mean', skip: true}\n"
+      "  - {metric: 'final.*.p99', skip: true}\n");
   const v1::JobResult baseline = RunJob(1.0, 1, 200);
   const GateReport same = RunGate(baseline, RunJob(1.0, 1, 200), rules, Options(false));
   EXPECT_TRUE(same.paired);

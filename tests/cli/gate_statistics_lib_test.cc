@@ -212,10 +212,10 @@ TEST(GateStatistics, PlanningPowerMatchesSimulation) {
   int detected = 0;
   for (int r = 0; r < kRepetitions; ++r) {
     const auto b = Normal(rng, n, 1.0), c = Normal(rng, n, 1.3);
-    detected += TestSigmaIndependent(SampleSd(b), n, SampleSd(c), n, 1.1, kAlpha).p_value <=
-                        alpha_per_test
-                    ? 1
-                    : 0;
+    detected +=
+        TestSigmaIndependent(SampleSd(b), n, SampleSd(c), n, 1.1, kAlpha).p_value <= alpha_per_test
+            ? 1
+            : 0;
   }
   EXPECT_NEAR(detected / double(kRepetitions), 0.9, Slack(0.9));
   // No run count detects a change inside the tolerance.

@@ -96,8 +96,8 @@ TEST(GateCommand, DegradedResultFailsWithExitOneAndNamesTheMetric) {
   const std::string command =
       "/usr/bin/python3 -c \"import sys, xml.etree.ElementTree as E; r = E.parse(sys.argv[1])"
       ".getroot(); assert r.tag == 'testsuite'; assert len(r.findall('testcase/failure')) == " +
-      std::to_string(failed.size()) + "; assert int(r.get('tests')) == " +
       std::to_string(failed.size()) +
+      "; assert int(r.get('tests')) == " + std::to_string(failed.size()) +
       "; p = {q.get('name'): q.get('value') for q in r.findall('properties/property')}"
       "; assert p['baseline'].endswith('gate_baseline.json'), p"
       "; assert p['current'].endswith('gate_degraded.json'), p"

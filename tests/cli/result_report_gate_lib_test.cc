@@ -490,8 +490,7 @@ TEST(Gate, LastMatchingRuleDecidesAndSkipRemovesMetrics) {
     const std::string statistic = row.metric.substr(row.metric.rfind('.') + 1);
     EXPECT_TRUE(statistic == "std" || statistic == "rms") << row.metric;
     // Paired, exact ratios: yaw within 60 % (1.5 <= 1.6) passes, everything else at 10 % fails.
-    EXPECT_EQ(row.decision == GateDecision::kRegression,
-              row.metric.rfind("final.yaw_deg.", 0) != 0)
+    EXPECT_EQ(row.decision == GateDecision::kRegression, row.metric.rfind("final.yaw_deg.", 0) != 0)
         << row.metric;
   }
   EXPECT_EQ(report.rows.size(), 11u * 2);
@@ -533,6 +532,37 @@ TEST(Gate, SeedAndRunCountAreNotPartOfTheJobButTheSensorIs) {
   EXPECT_TRUE(report.passed());
   ASSERT_FALSE(report.notes.empty());
   EXPECT_NE(report.notes[0].find("different jobs compared"), std::string::npos);
+}
+
+// The result with a filter consistency whose final average NEES over `runs` runs is `final_nees`
+// (9 states; earlier epochs 9).
+v1::JobResult WithNees(v1::JobResult result, double final_nees) {
+  v1::FilterConsistency* consistency = result.mutable_filter_consistency();
+  consistency->set_state_dimension(9);
+  for (int e = 0; e < result.epochs_size(); ++e) {
+    v1::NeesEpoch* nees = consistency->add_epochs();
+    nees->set_t_s(result.epochs(e).t_s());
+    nees->set_runs(result.run_count());
+    nees->set_average_nees(e + 1 == result.epochs_size() ? final_nees : 9.0);
+  }
+  return result;
+}
+
+TEST(Gate, NeesIsTestedWithItsChiSquareDegreesOfFreedom) {
+  // 1000 runs x 9 states: each average is chi2(9000) / 1000, whose ratio of two is F(9000, 9000)
+  // with 95 % interval x/÷ 1.042. 12 / 9 = 1.33 against the limit 1.1 is a regression
+  // (p ~ 1e-40); 9.2 / 9 = 1.022 has its interval's upper end 1.065 within the limit: pass.
+  const std::vector<GateRule> rules = {{"final.nees", 0, 0.1, false}};
+  const v1::JobResult baseline = WithNees(MakeResult(1.0, 1000), 9.0);
+  GateReport report =
+      RunGate(baseline, WithSeed(WithNees(MakeResult(1.0, 1000), 12.0), 7), rules, Allow(false));
+  ASSERT_EQ(report.rows.size(), 1u);
+  EXPECT_EQ(report.rows[0].decision, GateDecision::kRegression);
+  EXPECT_EQ(report.rows[0].test, "F(9000, 9000) NEES ratio (chi2 band)");
+  report =
+      RunGate(baseline, WithSeed(WithNees(MakeResult(1.0, 1000), 9.2), 7), rules, Allow(false));
+  EXPECT_EQ(report.rows[0].decision, GateDecision::kPass);
+  EXPECT_NEAR(report.rows[0].ratio_high, 9.2 / 9.0 * 1.042, 0.002);
 }
 
 TEST(Gate, MetricMissingFromTheCurrentResultFails) {

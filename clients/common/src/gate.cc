@@ -4,8 +4,8 @@
 #include <google/protobuf/util/message_differencer.h>
 
 #include <algorithm>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <limits>
 #include <unordered_map>
 
@@ -35,8 +35,8 @@ void AddEpochMetrics(const std::string& prefix, const v1::EpochStatistics& epoch
   Add({prefix + "rms", s.rms(), MetricKind::kRms, c, e, -1, 0, unit}, out);
 }
 
-void AddCheckpointMetrics(const std::string& prefix, const v1::Checkpoint& checkpoint, int k,
-                          int c, std::vector<Metric>& out) {
+void AddCheckpointMetrics(const std::string& prefix, const v1::Checkpoint& checkpoint, int k, int c,
+                          std::vector<Metric>& out) {
   const v1::ComponentPercentiles& p = checkpoint.components(c);
   const std::string unit = UnitOf(c);
   Add({prefix + "p50", p.p50(), MetricKind::kQuantile, c, -1, k, 0.50, unit}, out);
@@ -154,7 +154,8 @@ TestOutcome TestMetric(const v1::JobResult& baseline, const Metric& mb,
     const double t_s = baseline.epochs(mb.epoch).t_s();
     const std::vector<double> x =
         RunValues(baseline, CheckpointAt(baseline, t_s), mb.component, false);
-    const std::vector<double> y = RunValues(current, CheckpointAt(current, t_s), mc.component, false);
+    const std::vector<double> y =
+        RunValues(current, CheckpointAt(current, t_s), mc.component, false);
     if (x.size() >= 3 && x.size() == y.size()) {
       switch (mb.kind) {
         case MetricKind::kStd:
@@ -258,15 +259,16 @@ GateReport RunGate(const v1::JobResult& baseline, const v1::JobResult& current,
                                        baseline.engine_version(), current.engine_version()));
   }
   report.paired = SameRuns(baseline, current);
-  report.mode = report.paired
-                    ? fmt::format("paired: same seed {} and runs [{}, {}) in both files; "
-                                  "tests on the per-run differences",
-                                  baseline.seed(), baseline.first_run(),
-                                  baseline.first_run() + baseline.run_count())
-                    : fmt::format("independent: baseline seed {} with {} runs, current seed {} "
-                                  "with {} runs; two-sample tests",
-                                  baseline.seed(), baseline.run_count(), current.seed(),
-                                  current.run_count());
+  report.mode =
+      report.paired
+          ? fmt::format(
+                "paired: same seed {} and runs [{}, {}) in both files; "
+                "tests on the per-run differences",
+                baseline.seed(), baseline.first_run(), baseline.first_run() + baseline.run_count())
+          : fmt::format(
+                "independent: baseline seed {} with {} runs, current seed {} "
+                "with {} runs; two-sample tests",
+                baseline.seed(), baseline.run_count(), current.seed(), current.run_count());
 
   const std::vector<Metric> baseline_metrics = ListMetrics(baseline);
   std::vector<Metric> current_list = ListMetrics(current);
@@ -308,8 +310,8 @@ GateReport RunGate(const v1::JobResult& baseline, const v1::JobResult& current,
     } else {
       row.current = found->second->value;
       const double limit_ratio = row.limit / metric.value;
-      const TestOutcome outcome = TestMetric(baseline, metric, current, *found->second,
-                                             limit_ratio, report.paired, options.alpha);
+      const TestOutcome outcome = TestMetric(baseline, metric, current, *found->second, limit_ratio,
+                                             report.paired, options.alpha);
       row.ratio = outcome.ratio;
       row.ratio_low = outcome.ratio_low;
       row.ratio_high = outcome.ratio_high;
@@ -339,9 +341,9 @@ GateReport RunGate(const v1::JobResult& baseline, const v1::JobResult& current,
     const double limit_ratio = row.limit / row.baseline;
     if (rejected[t]) {
       row.decision = GateDecision::kRegression;
-      row.note = fmt::format("current {} > limit {} (baseline {}), p = {:.2g} ({})",
-                             Number(row.current), Number(row.limit), Number(row.baseline),
-                             row.p_value, row.test);
+      row.note =
+          fmt::format("current {} > limit {} (baseline {}), p = {:.2g} ({})", Number(row.current),
+                      Number(row.limit), Number(row.baseline), row.p_value, row.test);
     } else if (std::isnan(row.ratio)) {
       row.decision = GateDecision::kPass;  // exact comparison within the limit
     } else if (row.ratio_high < 1.0) {
@@ -360,9 +362,8 @@ GateReport RunGate(const v1::JobResult& baseline, const v1::JobResult& current,
   }
   const double m = static_cast<double>(std::max<size_t>(tested.size(), 1));
   if (baseline.run_count() >= 2 && current.run_count() >= 2) {
-    report.detectable_sigma_ratio =
-        DetectableSigmaRatio(baseline.run_count(), current.run_count(), 1.0 + kDefaultRelTol,
-                             options.alpha / m, 0.9);
+    report.detectable_sigma_ratio = DetectableSigmaRatio(
+        baseline.run_count(), current.run_count(), 1.0 + kDefaultRelTol, options.alpha / m, 0.9);
   }
   return report;
 }

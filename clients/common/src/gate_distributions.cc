@@ -103,8 +103,8 @@ double RegularizedBeta(double a, double b, double x) {
   if (x <= 0.0) return 0.0;
   if (x >= 1.0) return 1.0;
   // Prefactor x^a (1-x)^b / (a B(a, b)) (NR 6.4.5), in logs for large a, b.
-  const double log_front = std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) +
-                           a * std::log(x) + b * std::log1p(-x);
+  const double log_front =
+      std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x);
   // The fraction converges fast for x < (a + 1) / (a + b + 2); else use the symmetry (NR 6.4).
   if (x < (a + 1.0) / (a + b + 2.0)) {
     return std::exp(log_front) * BetaContinuedFraction(a, b, x) / a;

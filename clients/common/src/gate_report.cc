@@ -49,9 +49,9 @@ std::string Number(double value) { return fmt::format("{:.6g}", value); }
 // "1.04 [0.93, 1.17]" (ratio and its interval); "-" when there is none.
 std::string RatioText(const GateRow& row) {
   if (std::isnan(row.ratio)) return "-";
-  return fmt::format("{:.3f} [{:.3f}, {}]", row.ratio, row.ratio_low,
-                     std::isinf(row.ratio_high) ? std::string("inf")
-                                                : fmt::format("{:.3f}", row.ratio_high));
+  return fmt::format(
+      "{:.3f} [{:.3f}, {}]", row.ratio, row.ratio_low,
+      std::isinf(row.ratio_high) ? std::string("inf") : fmt::format("{:.3f}", row.ratio_high));
 }
 
 std::string LimitRatioText(const GateRow& row) {
@@ -101,16 +101,18 @@ std::string FormatGateTable(const GateReport& report) {
                        LimitRatioText(row), DecisionName(row.decision), row.test);
     if (Fails(report, row)) failed.push_back(row.metric);
   }
-  out += fmt::format("ratio = current / baseline with its {:g} % interval; limit = 1 + tolerance; "
-                     "alpha {} family-wise (Holm) over {} metrics{}\n",
-                     100.0 * (1.0 - report.options.alpha), report.options.alpha,
-                     report.rows.size(), report.options.strict ? "; --strict" : "");
+  out += fmt::format(
+      "ratio = current / baseline with its {:g} % interval; limit = 1 + tolerance; "
+      "alpha {} family-wise (Holm) over {} metrics{}\n",
+      100.0 * (1.0 - report.options.alpha), report.options.alpha, report.rows.size(),
+      report.options.strict ? "; --strict" : "");
   out += PlanningText(report);
   const size_t passed = report.rows.size() - report.regressions - report.inconclusive;
   if (report.passed()) {
-    out += fmt::format("gate: PASS, {} metrics: {} pass or improved, {} inconclusive, no "
-                       "regression\n",
-                       report.rows.size(), passed, report.inconclusive);
+    out += fmt::format(
+        "gate: PASS, {} metrics: {} pass or improved, {} inconclusive, no "
+        "regression\n",
+        report.rows.size(), passed, report.inconclusive);
   } else {
     out += fmt::format("gate: FAIL, {} of {} metrics {}: {}\n", failed.size(), report.rows.size(),
                        report.options.strict ? "regressed or inconclusive (--strict)" : "regressed",

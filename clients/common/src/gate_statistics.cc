@@ -112,9 +112,8 @@ BinomialTails Tails(long n, double p) {
   std::vector<double> pmf(static_cast<size_t>(n) + 1);
   const double log_n = std::lgamma(n + 1.0);
   for (long i = 0; i <= n; ++i) {
-    pmf[static_cast<size_t>(i)] =
-        std::exp(log_n - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) + i * std::log(p) +
-                 (n - i) * std::log1p(-p));
+    pmf[static_cast<size_t>(i)] = std::exp(log_n - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) +
+                                           i * std::log(p) + (n - i) * std::log1p(-p));
   }
   BinomialTails t;
   t.lower.assign(static_cast<size_t>(n) + 2, 0.0);
@@ -151,8 +150,8 @@ QuantileBounds Bounds(const std::vector<double>& sorted, const BinomialTails& t,
 
 }  // namespace
 
-TestOutcome TestSigmaIndependent(double s_b, double n_b, double s_c, double n_c,
-                                 double limit_ratio, double alpha) {
+TestOutcome TestSigmaIndependent(double s_b, double n_b, double s_c, double n_c, double limit_ratio,
+                                 double alpha) {
   TestOutcome out;
   const double nu_c = n_c - 1.0, nu_b = n_b - 1.0;
   out.ratio = s_c / s_b;
@@ -190,8 +189,8 @@ TestOutcome TestAbsMeanWelch(double mean_b, double s_b, double n_b, double mean_
   // denominator is left out: an approximation for display; the decision uses the test above).
   double df1 = 0.0;
   const double se1 = welch(1.0, &df1);
-  const double half = (se1 > 0.0 ? StudentTQuantile(1.0 - alpha / 2.0, df1) * se1 : 0.0) /
-                      std::abs(mean_b);
+  const double half =
+      (se1 > 0.0 ? StudentTQuantile(1.0 - alpha / 2.0, df1) * se1 : 0.0) / std::abs(mean_b);
   out.ratio_low = std::max(0.0, out.ratio - half);
   out.ratio_high = out.ratio + half;
   out.test = fmt::format("Welch t (df {:.1f})", df);
@@ -214,7 +213,8 @@ TestOutcome TestQuantile(std::vector<double> baseline, std::vector<double> curre
     const double y = current[static_cast<size_t>(k - 1)];
     while (j < n_b && limit_ratio * baseline[static_cast<size_t>(j)] < y) ++j;
     if (j == 0) continue;
-    p_value = std::min(p_value, tc.lower[static_cast<size_t>(k)] + tb.upper[static_cast<size_t>(j)]);
+    p_value =
+        std::min(p_value, tc.lower[static_cast<size_t>(k)] + tb.upper[static_cast<size_t>(j)]);
   }
   out.p_value = p_value;
   // Hyndman & Fan definition 7, as the result file's percentiles.
@@ -305,8 +305,8 @@ TestOutcome TestAbsMeanPaired(const std::vector<double>& x, const std::vector<do
   return out;
 }
 
-TestOutcome TestQuantilePaired(const std::vector<double>& x, const std::vector<double>& y,
-                               double p, double limit_ratio, double alpha) {
+TestOutcome TestQuantilePaired(const std::vector<double>& x, const std::vector<double>& y, double p,
+                               double limit_ratio, double alpha) {
   const size_t n = x.size();
   // Hyndman & Fan definition 7 by two partial sorts (the result file's percentiles).
   const auto quantile = [p](std::vector<double>& v) {

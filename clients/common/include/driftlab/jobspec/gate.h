@@ -111,15 +111,15 @@ struct GateRow {
   std::string metric;
   std::string unit;
   double baseline = 0;
-  double current = 0;  // NaN when the metric is missing from the current result
-  double limit = 0;    // baseline + max(abs_tol, rel_tol * |baseline|)
-  double ratio = 0;    // current / baseline (NaN when the baseline is 0)
+  double current = 0;                    // NaN when the metric is missing from the current result
+  double limit = 0;                      // baseline + max(abs_tol, rel_tol * |baseline|)
+  double ratio = 0;                      // current / baseline (NaN when the baseline is 0)
   double ratio_low = 0, ratio_high = 0;  // (1 - alpha) interval of the population ratio
-  double p_value = 1;  // one-sided, of H0: current <= limit (before Holm)
-  std::string test;    // the test used
+  double p_value = 1;                    // one-sided, of H0: current <= limit (before Holm)
+  std::string test;                      // the test used
   GateDecision decision = GateDecision::kInconclusive;
-  std::string note;    // why it failed ("missing in the current result"), else empty
-  double wall_s = 0;   // time spent on this metric's test [s]
+  std::string note;   // why it failed ("missing in the current result"), else empty
+  double wall_s = 0;  // time spent on this metric's test [s]
 };
 
 struct GateOptions {
@@ -134,8 +134,8 @@ struct GateReport {
   int inconclusive = 0;
   GateOptions options;
   bool paired = false;
-  std::string mode;                // "paired (...)" or "independent (...)", why
-  std::string job_name;            // the baseline's job name (JUnit suite name)
+  std::string mode;                         // "paired (...)" or "independent (...)", why
+  std::string job_name;                     // the baseline's job name (JUnit suite name)
   std::string baseline_file, current_file;  // set by the caller, for the table and JUnit
   uint32_t baseline_runs = 0, current_runs = 0;
   std::vector<std::string> notes;  // e.g. different engine versions; informational

@@ -43,8 +43,8 @@ struct TestOutcome {
   std::string test;  // e.g. "F(199, 199) variance ratio"
 };
 
-TestOutcome TestSigmaIndependent(double s_b, double n_b, double s_c, double n_c,
-                                 double limit_ratio, double alpha);
+TestOutcome TestSigmaIndependent(double s_b, double n_b, double s_c, double n_c, double limit_ratio,
+                                 double alpha);
 TestOutcome TestRmsIndependent(double rms_b, double n_b, double rms_c, double n_c,
                                double limit_ratio, double alpha);
 TestOutcome TestAbsMeanWelch(double mean_b, double s_b, double n_b, double mean_c, double s_c,
@@ -64,8 +64,8 @@ TestOutcome TestRmsPaired(const std::vector<double>& x, const std::vector<double
                           double limit_ratio, double alpha);
 inline constexpr int kBootstrapResamples = 3999;
 // x, y: |error| of the runs, paired.
-TestOutcome TestQuantilePaired(const std::vector<double>& x, const std::vector<double>& y,
-                               double p, double limit_ratio, double alpha);
+TestOutcome TestQuantilePaired(const std::vector<double>& x, const std::vector<double>& y, double p,
+                               double limit_ratio, double alpha);
 TestOutcome TestAbsMeanPaired(const std::vector<double>& x, const std::vector<double>& y,
                               double limit_ratio, double alpha);
 
