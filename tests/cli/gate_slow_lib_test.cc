@@ -31,30 +31,13 @@
 namespace driftlab::jobspec {
 namespace {
 
-// 32 s drive at 50 Hz: 2 s standing, 5 s accelerating to 10 m/s, 25 s straight; a navigation-grade
-// ARW large enough to dominate, nothing else. Epochs every 4 s keep the results small.
-constexpr char kJob[] = R"({
-  "name": "gate_arw_drive",
-  "motion": {
-    "earth_model": "WGS84",
-    "initial": {"lat_deg": 48.0, "lon_deg": 11.0, "height_m": 500.0, "yaw_deg": 30.0},
-    "segments": [
-      {"static": {"duration_s": 2}},
-      {"accelerate": {"acceleration_m_per_s2": 2.0, "target_speed_m_per_s": 10.0}},
-      {"constant_velocity": {"duration_s": 25}}
-    ]
-  },
-  "rate_hz": 50,
-  "navigation": {"mechanization": "NED", "ned": {"vertical_channel": "FREE"}},
-  "sensor": {"gyro": {"arw_deg_per_sqrt_h": 0.5}},
-  "monte_carlo": {"runs": 200, "seed": 1, "epoch_interval_s": 4.0}
-})";
-
+// tests/cli/data/gate_arw_drive.json: a 32 s drive at 50 Hz (2 s standing, 5 s accelerating to
+// 10 m/s, 25 s straight) with gyro ARW 0.5 deg/sqrt(h) and nothing else; 200 runs; epochs every
+// 4 s keep the results small.
 constexpr double kArwDegPerSqrtH = 0.5;
 
 v1::JobResult RunJob(double arw_scale, uint64_t seed, uint32_t runs) {
-  JobFile file;
-  file.job = ParseJobJson(kJob);
+  JobFile file = LoadJobFile(std::string(DRIFTLAB_CLI_TEST_DATA) + "/gate_arw_drive.json");
   file.job.mutable_sensor()->mutable_gyro()->set_arw_deg_per_sqrt_h(kArwDegPerSqrtH * arw_scale);
   MonteCarloOverrides overrides;
   overrides.runs = runs;
