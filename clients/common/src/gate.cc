@@ -133,7 +133,9 @@ TestOutcome TestMetric(const v1::JobResult& baseline, const Metric& mb,
       none.test = "none: per-run values not kept";
       return none;
     }
-    if (paired && xb.size() == xc.size() && xb.size() >= 3) {
+    // The bootstrap costs B x n per metric; above kMaxBootstrapRuns the order-statistic bounds
+    // (valid for paired samples too) are tight enough and far cheaper.
+    if (paired && xb.size() == xc.size() && xb.size() >= 3 && xb.size() <= kMaxBootstrapRuns) {
       TestOutcome out = TestQuantilePaired(xb, xc, mb.quantile, limit_ratio, alpha);
       out.ratio = mc.value / mb.value;
       return out;
@@ -147,6 +149,13 @@ TestOutcome TestMetric(const v1::JobResult& baseline, const Metric& mb,
     const double runs_b = baseline.filter_consistency().epochs(mb.epoch).runs();
     const double runs_c = current.filter_consistency().epochs(mc.epoch).runs();
     return TestNees(mb.value, dof * runs_b, mc.value, dof * runs_c, limit_ratio, alpha);
+  }
+  if (mb.kind != MetricKind::kRms && (n_b < 2 || n_c < 2)) {
+    TestOutcome none;
+    none.ratio = mc.value / mb.value;
+    none.ratio_high = std::numeric_limits<double>::infinity();
+    none.test = "none: one run has no sigma";
+    return none;
   }
   // Moments: paired on the per-run values of the checkpoint at the epoch's time, when there is
   // one; else from the files' moments.

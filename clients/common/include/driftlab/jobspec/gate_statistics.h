@@ -30,6 +30,7 @@
 //             interval (Efron & Tibshirani, An Introduction to the Bootstrap, 1993, ch. 13, 16)
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,8 @@ TestOutcome TestSigmaPaired(const std::vector<double>& x, const std::vector<doub
 TestOutcome TestRmsPaired(const std::vector<double>& x, const std::vector<double>& y,
                           double limit_ratio, double alpha);
 inline constexpr int kBootstrapResamples = 3999;
+// Above this run count the gate uses TestQuantile for paired samples too (cost B x n per metric).
+inline constexpr size_t kMaxBootstrapRuns = 2000;
 // x, y: |error| of the runs, paired.
 TestOutcome TestQuantilePaired(const std::vector<double>& x, const std::vector<double>& y, double p,
                                double limit_ratio, double alpha);
