@@ -16,7 +16,12 @@
 namespace driftlab::jobspec {
 namespace {
 
+// The sanitizer build runs a quarter of the repetitions (the slack below follows).
+#ifdef DRIFTLAB_SANITIZE
+constexpr int kRepetitions = 500;
+#else
 constexpr int kRepetitions = 2000;
+#endif
 constexpr double kAlpha = 0.05;
 
 // 4 binomial standard deviations of a rate q over kRepetitions.
