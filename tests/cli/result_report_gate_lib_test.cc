@@ -450,7 +450,8 @@ TEST(Gate, FiftyRunsCannotTellAFiftyPercentChangeFromNoiseAndSaySo) {
   EXPECT_EQ(report.failures(), report.inconclusive);
   // The planning line states the smallest change these run counts detect: > 50 %.
   EXPECT_GT(report.detectable_sigma_ratio, 1.5);
-  EXPECT_NE(FormatGateTable(report).find("planning: with 50 and 50 runs"), std::string::npos);
+  EXPECT_NE(FormatGateTable(report).find("planning: with independent samples of 50 and 50 runs"),
+            std::string::npos);
 }
 
 TEST(Gate, LimitIsBaselinePlusLargerOfAbsoluteAndRelativeTolerance) {

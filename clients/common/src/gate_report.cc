@@ -67,9 +67,10 @@ bool Fails(const GateReport& report, const GateRow& row) {
 std::string PlanningText(const GateReport& report) {
   if (!(report.detectable_sigma_ratio > 0)) return "";
   return fmt::format(
-      "planning: with {} and {} runs, a sigma that grew by {:.0f} % (10 % tolerance) is a "
-      "regression with 90 % power at alpha {} over {} metrics; `driftlab gate BASELINE "
-      "--runs-for-change 0.3` gives the runs for a change\n",
+      "planning: with independent samples of {} and {} runs, a sigma that grew by {:.0f} % (10 % "
+      "tolerance) is a regression with 90 % power at alpha {} over {} metrics (paired samples "
+      "detect less); `driftlab gate BASELINE --runs-for-change 0.3` gives the runs for a "
+      "change\n",
       report.baseline_runs, report.current_runs, 100.0 * (report.detectable_sigma_ratio - 1.0),
       report.options.alpha, report.rows.size());
 }
