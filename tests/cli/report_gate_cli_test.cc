@@ -24,12 +24,12 @@ size_t Count(const std::string& text, const std::string& what) {
   return n;
 }
 
-// Lines of `text` that end in " FAIL" (the gate table's regressions).
+// Lines of the gate table whose decision is "regression".
 std::vector<std::string> FailLines(const std::string& text) {
   std::vector<std::string> lines;
   std::istringstream in(text);
   for (std::string line; std::getline(in, line);) {
-    if (line.size() > 5 && line.compare(line.size() - 5, 5, " FAIL") == 0) lines.push_back(line);
+    if (line.find("  regression  ") != std::string::npos) lines.push_back(line);
   }
   return lines;
 }
@@ -76,33 +76,46 @@ TEST(GateCommand, DegradedResultFailsWithExitOneAndNamesTheMetric) {
   const Result r =
       RunDriftlab({"gate", kDegraded, "--baseline", kBaseline, "--junit", junit.string()}, scratch);
   EXPECT_EQ(r.exit_status, 1) << r.out << r.err;
-  // Every default-gated final statistic is 1.5 x its baseline, above the loosest default
-  // tolerance (40 %, max_abs): all of them fail, CEP95 among them.
+  // Same seed and runs: paired. Every run's error is 1.5 x the baseline's, so the paired tests
+  // of sigma and RMS see the ratio 1.5 without noise against the 10 % limit, and so does the
+  // paired bootstrap of the percentiles (every resampled ratio is 1.5): all 11 x 5 default
+  // metrics regress, p95 of the horizontal error (CEP95) among them.
+  EXPECT_NE(r.out.find("mode: paired"), std::string::npos) << r.out;
   const std::vector<std::string> failed = FailLines(r.out);
-  EXPECT_EQ(failed.size(), 11u * 7 + 3);
+  EXPECT_EQ(failed.size(), 11u * 5) << r.out;
   EXPECT_NE(r.out.find("gate: FAIL"), std::string::npos);
-  bool cep95 = false;
+  bool p95 = false;
   for (const std::string& line : failed) {
-    cep95 = cep95 || line.rfind("final.horizontal_position_m.cep95 ", 0) == 0;
+    p95 = p95 || line.rfind("final.horizontal_position_m.p95 ", 0) == 0;
   }
-  EXPECT_TRUE(cep95) << r.out;
-  // The JUnit file is XML that Python's parser (as CI tools) reads: one suite, one failure per
-  // regression.
+  EXPECT_TRUE(p95) << r.out;
+  EXPECT_NE(r.out.find("unit"), std::string::npos);
+  EXPECT_NE(r.out.find("1.500 [1.500, 1.500]"), std::string::npos) << r.out;
+  // The JUnit file is XML that Python's parser (as CI tools) reads: one suite naming both files,
+  // one failure per regression, each case with its test and time.
   const std::string command =
       "/usr/bin/python3 -c \"import sys, xml.etree.ElementTree as E; r = E.parse(sys.argv[1])"
       ".getroot(); assert r.tag == 'testsuite'; assert len(r.findall('testcase/failure')) == " +
       std::to_string(failed.size()) +
-      "; assert int(r.get('tests')) == " + std::to_string(failed.size()) + "\" " + junit.string();
+      "; assert int(r.get('tests')) == " + std::to_string(failed.size()) +
+      "; p = {q.get('name'): q.get('value') for q in r.findall('properties/property')}"
+      "; assert p['baseline'].endswith('gate_baseline.json'), p"
+      "; assert p['current'].endswith('gate_degraded.json'), p"
+      "; assert all('test: ' in c.find('failure').text for c in r.findall('testcase'))"
+      "; assert all(float(c.get('time')) >= 0 for c in r.findall('testcase'))\" " +
+      junit.string();
   EXPECT_EQ(std::system(command.c_str()), 0) << command;
   // The improved direction passes: errors, larger is worse.
-  EXPECT_EQ(RunDriftlab({"gate", kBaseline, "--baseline", kDegraded}, scratch).exit_status, 0);
+  const Result better = RunDriftlab({"gate", kBaseline, "--baseline", kDegraded}, scratch);
+  EXPECT_EQ(better.exit_status, 0) << better.out;
+  EXPECT_EQ(Count(better.out, "  improved  "), 11u * 5) << better.out;
 }
 
 TEST(GateCommand, DifferentJobIsRefusedUnlessAllowed) {
   Scratch scratch;
   const Result refused = RunDriftlab({"gate", kOtherJob, "--baseline", kBaseline}, scratch);
   EXPECT_EQ(refused.exit_status, 2);
-  EXPECT_NE(refused.err.find("different job"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("job.rate_hz: differs"), std::string::npos) << refused.err;
   EXPECT_NE(refused.err.find("rate_hz: 100 -> 200"), std::string::npos) << refused.err;
   EXPECT_NE(refused.err.find("--allow-different-job"), std::string::npos) << refused.err;
   const Result allowed =
@@ -111,9 +124,40 @@ TEST(GateCommand, DifferentJobIsRefusedUnlessAllowed) {
   EXPECT_NE(allowed.out.find("note: different jobs compared"), std::string::npos);
 }
 
+TEST(GateCommand, StrictFailsOnInconclusiveAndAlphaIsChecked) {
+  Scratch scratch;
+  // The baseline against itself: every paired test sees ratio 1 exactly; nothing inconclusive,
+  // so --strict passes too.
+  const Result same =
+      RunDriftlab({"gate", kBaseline, "--baseline", kBaseline, "--strict"}, scratch);
+  EXPECT_EQ(same.exit_status, 0) << same.out << same.err;
+  const Result bad_alpha =
+      RunDriftlab({"gate", kBaseline, "--baseline", kBaseline, "--alpha", "1.5"}, scratch);
+  EXPECT_EQ(bad_alpha.exit_status, 2);
+  EXPECT_NE(bad_alpha.err.find("--alpha: 1.5 is not allowed; allowed: 0 < alpha < 1"),
+            std::string::npos)
+      << bad_alpha.err;
+}
+
+TEST(GateCommand, RunsForChangePlansTheRunCount) {
+  Scratch scratch;
+  const Result r = RunDriftlab({"gate", kBaseline, "--runs-for-change", "0.3"}, scratch);
+  ASSERT_EQ(r.exit_status, 0) << r.err;
+  EXPECT_NE(r.out.find("runs per file (baseline and current) for a sigma grown by 30 %"),
+            std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("over 55 gated metrics"), std::string::npos) << r.out;
+  const Result inside = RunDriftlab({"gate", kBaseline, "--runs-for-change", "0.05"}, scratch);
+  EXPECT_EQ(inside.exit_status, 0);
+  EXPECT_NE(inside.out.find("within the 10 % tolerance"), std::string::npos) << inside.out;
+  const Result bad = RunDriftlab({"gate", kBaseline, "--runs-for-change", "-1"}, scratch);
+  EXPECT_EQ(bad.exit_status, 2);
+  EXPECT_NE(bad.err.find("--runs-for-change: -1 is not allowed"), std::string::npos) << bad.err;
+}
+
 TEST(GateCommand, RulesFileDecidesWhatIsGatedAndHowTightly) {
   Scratch scratch;
-  // 60 % everywhere: 1.5 x passes.
+  // 60 % everywhere: 1.5 x passes (paired, exact ratios).
   const Result loose = RunDriftlab(
       {"gate", kDegraded, "--baseline", kBaseline, "--rules", (kData / "gate_rules.yaml").string()},
       scratch);
@@ -152,9 +196,9 @@ TEST(GateCommand, ListMetricsPrintsEveryNameWithItsValue) {
   Scratch scratch;
   const Result r = RunDriftlab({"gate", kBaseline, "--list-metrics"}, scratch);
   ASSERT_EQ(r.exit_status, 0) << r.err;
-  // final: 11 x 12 + 3; 11 epochs x 11 x 7; 2 checkpoints x (11 x 5 + 3).
-  EXPECT_EQ(Count(r.out, "\n"), 11u * 12 + 3 + 11u * 11 * 7 + 2u * (11 * 5 + 3));
-  EXPECT_NE(r.out.find("\nfinal.horizontal_position_m.cep95 "), std::string::npos);
+  // final: 11 x 7; 11 epochs x 11 x 3; 2 checkpoints x 11 x 4.
+  EXPECT_EQ(Count(r.out, "\n"), 11u * 7 + 11u * 11 * 3 + 2u * 11 * 4);
+  EXPECT_NE(r.out.find("\nfinal.horizontal_position_m.p95 "), std::string::npos);
   EXPECT_NE(r.out.find("\nepoch[t=600].velocity_down_m_per_s.std "), std::string::npos);
   EXPECT_NE(r.out.find("\ncheckpoint[t=300].yaw_deg.p95 "), std::string::npos);
 }

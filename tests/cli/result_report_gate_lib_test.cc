@@ -316,12 +316,17 @@ TEST(ResultFile, OneRunResultHasUndefinedSigma) {
 TEST(Gate, MetricNamesFollowTheGrammarAndReadTheRightField) {
   const v1::JobResult result = MakeResult(1.0);
   const std::vector<Metric> metrics = ListMetrics(result);
-  // final: 11 x (7 epoch + 5 checkpoint) + 3 (CEP50, CEP95, 2DRMS); each epoch 11 x 7; each
-  // checkpoint 11 x 5 + 3.
-  EXPECT_EQ(metrics.size(), 11u * 12 + 3 + 11u * 11 * 7 + 2u * (11 * 5 + 3));
+  // One metric per quantity: final 11 x (3 moments + 4 percentiles); each of the 11 epochs 11 x 3;
+  // each of the 2 checkpoints 11 x 4. No CEP (= p50, p95 of horizontal_position_m), 2DRMS (=
+  // 2 x its rms), interval bounds or maxima.
+  EXPECT_EQ(metrics.size(), 11u * 7 + 11u * 11 * 3 + 2u * 11 * 4);
+  for (const Metric& m : metrics) {
+    for (const char* gone : {"cep", "drms", "ci95", "max_abs"}) {
+      EXPECT_EQ(m.name.find(gone), std::string::npos) << m.name;
+    }
+  }
   const v1::Checkpoint& last = result.checkpoints(1);
-  EXPECT_EQ(MetricValue(metrics, "final.horizontal_position_m.cep95"), last.cep95_m());
-  EXPECT_EQ(MetricValue(metrics, "final.horizontal_position_m.drms2"), last.drms2_m());
+  EXPECT_EQ(MetricValue(metrics, "final.horizontal_position_m.p95"), last.components(9).p95());
   EXPECT_EQ(MetricValue(metrics, "final.position_north_m.p95"), last.components(0).p95());
   EXPECT_EQ(MetricValue(metrics, "final.yaw_deg.rms"), result.epochs(10).components(8).rms());
   // abs_mean is |mean|: the synthetic north bias is negative.
@@ -329,17 +334,31 @@ TEST(Gate, MetricNamesFollowTheGrammarAndReadTheRightField) {
             -result.epochs(10).components(0).mean());
   EXPECT_EQ(MetricValue(metrics, "epoch[t=600].velocity_down_m_per_s.std"),
             result.epochs(10).components(5).std());
-  EXPECT_EQ(MetricValue(metrics, "epoch[t=60].roll_deg.rms_ci95_high"),
-            result.epochs(1).components(6).rms_ci95_high());
   EXPECT_EQ(MetricValue(metrics, "checkpoint[t=300].position_3d_m.p99"),
             result.checkpoints(0).components(10).p99());
-  EXPECT_EQ(MetricValue(metrics, "checkpoint[t=300].horizontal_position_m.cep50"),
-            result.checkpoints(0).cep50_m());
+  for (const Metric& m : metrics) {
+    if (m.name == "final.velocity_east_m_per_s.std") {
+      EXPECT_EQ(m.unit, "m/s");
+    }
+    if (m.name == "final.yaw_deg.p50") {
+      EXPECT_EQ(m.unit, "deg");
+    }
+  }
   // A fractional time prints in the shortest form that reads back.
   v1::JobResult half = MakeResult(1.0);
   half.mutable_epochs(1)->set_t_s(0.5);
   EXPECT_EQ(MetricValue(ListMetrics(half), "epoch[t=0.5].pitch_deg.std"),
             half.epochs(1).components(7).std());
+  // NEES: final.nees from the final epoch of the filter consistency.
+  v1::JobResult filtered = MakeResult(1.0);
+  filtered.mutable_filter_consistency()->set_state_dimension(9);
+  for (int e = 0; e < filtered.epochs_size(); ++e) {
+    v1::NeesEpoch* nees = filtered.mutable_filter_consistency()->add_epochs();
+    nees->set_t_s(filtered.epochs(e).t_s());
+    nees->set_runs(50);
+    nees->set_average_nees(9.0 + e);
+  }
+  EXPECT_EQ(MetricValue(ListMetrics(filtered), "final.nees"), 19.0);
 }
 
 TEST(Gate, GlobMatchesStarAndQuestionMarkAndTakesBracketsLiterally) {
@@ -355,29 +374,84 @@ TEST(Gate, GlobMatchesStarAndQuestionMarkAndTakesBracketsLiterally) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Gate: comparisons
+// Gate: comparisons. MakeResult(s) with the same seed and runs is paired (run r of both files
+// drew the same random numbers; here the current per-run values are exactly s times the
+// baseline's, so the paired tests see the ratio without noise); a different seed makes the samples
+// independent, decided from the files' moments and run counts.
 
-TEST(Gate, IdenticalResultPasses) {
-  const v1::JobResult result = MakeResult(1.0);
-  const GateReport report = RunGate(result, result, DefaultGateRules(), false);
-  EXPECT_TRUE(report.passed());
-  // Default rules: final.* less abs_mean and the 4 CI bounds: 11 x (7 - 5 + 5) + 3.
-  EXPECT_EQ(report.rows.size(), 11u * 7 + 3);
-  for (const GateRow& row : report.rows) EXPECT_EQ(row.metric.rfind("final.", 0), 0u);
+// The options of the old boolean argument.
+GateOptions Allow(bool allow_different_job) {
+  GateOptions options;
+  options.allow_different_job = allow_different_job;
+  return options;
 }
 
-TEST(Gate, ErrorsFiftyPercentLargerFailEveryDefaultMetric) {
-  const v1::JobResult baseline = MakeResult(1.0);
-  const v1::JobResult degraded = MakeResult(1.5);
-  const GateReport report = RunGate(baseline, degraded, DefaultGateRules(), false);
-  // Every gated final statistic is 1.5 x its baseline (> 1.4 x, the loosest default, max_abs);
-  // none is zero at t = 600 s.
-  EXPECT_EQ(report.failures, static_cast<int>(report.rows.size()));
+v1::JobResult WithSeed(v1::JobResult result, uint64_t seed) {
+  result.set_seed(seed);
+  return result;
+}
+
+TEST(Gate, IdenticalResultPassesInPairedMode) {
+  const v1::JobResult result = MakeResult(1.0);
+  const GateReport report = RunGate(result, result, DefaultGateRules(), Allow(false));
+  EXPECT_TRUE(report.paired);
+  EXPECT_EQ(report.mode.rfind("paired", 0), 0u) << report.mode;
+  EXPECT_TRUE(report.passed());
+  EXPECT_EQ(report.regressions, 0);
+  // Default rules: final.* less abs_mean and p99: 11 x (2 moments + 3 percentiles).
+  EXPECT_EQ(report.rows.size(), 11u * 5);
+  for (const GateRow& row : report.rows) {
+    EXPECT_EQ(row.metric.rfind("final.", 0), 0u);
+    // Paired moments of identical runs: the ratio is 1 exactly, interval [1, 1] to bisection.
+    if (row.metric.find(".std") != std::string::npos) {
+      EXPECT_EQ(row.decision, GateDecision::kPass) << row.metric;
+      EXPECT_NEAR(row.ratio_high, 1.0, 1e-9) << row.metric;
+    }
+  }
+}
+
+TEST(Gate, ErrorsFiftyPercentLargerAreRegressionsForIndependentSamplesOfEnoughRuns) {
+  // 1000 runs each, independent seeds: sigma ratio 1.5 against the limit 1.1 is F = (1.5 / 1.1)^2
+  // = 1.86 with (999, 999) degrees of freedom, p ~ 1e-21, far below alpha / 55 after Holm; the
+  // percentiles' order-statistic bounds at n = 1000 are within a few % of the quantile.
+  const v1::JobResult baseline = MakeResult(1.0, 1000);
+  const v1::JobResult degraded = WithSeed(MakeResult(1.5, 1000), 7);
+  const GateReport report = RunGate(baseline, degraded, DefaultGateRules(), Allow(false));
+  EXPECT_FALSE(report.paired);
+  EXPECT_EQ(report.mode.rfind("independent", 0), 0u) << report.mode;
+  EXPECT_EQ(report.regressions, static_cast<int>(report.rows.size()));
   const std::string table = FormatGateTable(report);
-  EXPECT_NE(table.find("final.horizontal_position_m.cep95"), std::string::npos);
+  EXPECT_NE(table.find("final.horizontal_position_m.p95"), std::string::npos);
+  EXPECT_NE(table.find("regression"), std::string::npos);
   EXPECT_NE(table.find("gate: FAIL"), std::string::npos);
-  // The improved direction never fails: errors, larger is worse.
-  EXPECT_TRUE(RunGate(degraded, baseline, DefaultGateRules(), false).passed());
+  EXPECT_NE(table.find("F(999, 999) variance ratio"), std::string::npos) << table;
+  // The improved direction never fails: errors, larger is worse; every interval lies below 1.
+  const GateReport better = RunGate(degraded, baseline, DefaultGateRules(), Allow(false));
+  EXPECT_TRUE(better.passed());
+  for (const GateRow& row : better.rows) {
+    EXPECT_EQ(row.decision, GateDecision::kImproved) << row.metric;
+  }
+}
+
+TEST(Gate, FiftyRunsCannotTellAFiftyPercentChangeFromNoiseAndSaySo) {
+  // 50 runs each, independent: the 95 % interval of a sigma ratio is about x/÷ 1.76 (F(49, 49)
+  // 2.5 % and 97.5 % points 0.57 and 1.76), so 1.5 against a limit of 1.1 is not shown at
+  // alpha / 55: inconclusive, which fails only with --strict.
+  const v1::JobResult baseline = MakeResult(1.0, 50);
+  const v1::JobResult degraded = WithSeed(MakeResult(1.5, 50), 7);
+  GateOptions options;
+  GateReport report = RunGate(baseline, degraded, DefaultGateRules(), options);
+  EXPECT_EQ(report.regressions, 0);
+  EXPECT_GT(report.inconclusive, 0);
+  EXPECT_TRUE(report.passed());
+  options.strict = true;
+  report = RunGate(baseline, degraded, DefaultGateRules(), options);
+  EXPECT_FALSE(report.passed());
+  EXPECT_EQ(report.failures(), report.inconclusive);
+  // The planning line states the smallest change these run counts detect: > 50 %.
+  EXPECT_GT(report.detectable_sigma_ratio, 1.5);
+  EXPECT_NE(FormatGateTable(report).find("planning: with independent samples of 50 and 50 runs"),
+            std::string::npos);
 }
 
 TEST(Gate, LimitIsBaselinePlusLargerOfAbsoluteAndRelativeTolerance) {
@@ -385,26 +459,22 @@ TEST(Gate, LimitIsBaselinePlusLargerOfAbsoluteAndRelativeTolerance) {
   // final.yaw_deg.rms baseline = 1.005 * 9 = 9.045 deg.
   const std::string metric = "final.yaw_deg.rms";
   const double b = 1.005 * 9;
-  // 5 % worse passes a 10 % rule, 15 % worse fails it (limit 1.1 b: current/limit = 1.05/1.1
-  // and 1.15/1.1, far from rounding).
+  // Paired runs scaled by 1.05 pass a 10 % rule, by 1.15 fail it: the paired t on y^2 - rho^2 x^2
+  // has the sign of s^2 - rho^2 for every run, |t| = mean(x^2) / (sd(x^2) / sqrt(50)) ~ 10.
   const std::vector<GateRule> rel = {{metric, 0, 0.10, false}};
-  GateReport report = RunGate(baseline, MakeResult(1.05), rel, false);
+  GateReport report = RunGate(baseline, MakeResult(1.05), rel, Allow(false));
   ASSERT_EQ(report.rows.size(), 1u);
   EXPECT_DOUBLE_EQ(report.rows[0].limit, 1.1 * b);  // 1-ulp products: tolerance 4 ulp
+  EXPECT_NEAR(report.rows[0].ratio, 1.05, 1e-12);
   EXPECT_TRUE(report.passed());
-  EXPECT_FALSE(RunGate(baseline, MakeResult(1.15), rel, false).passed());
-  // abs_tol 2 deg > 0.10 * 9.045: limit b + 2, so 1.15 b = b + 1.36 passes, 1.25 b = b + 2.26
-  // fails.
+  EXPECT_EQ(report.rows[0].decision, GateDecision::kPass);
+  EXPECT_FALSE(RunGate(baseline, MakeResult(1.15), rel, Allow(false)).passed());
+  // abs_tol 2 deg > 0.10 * 9.045: limit b + 2 = 1.221 b, so 1.15 b passes, 1.25 b fails.
   const std::vector<GateRule> both = {{metric, 2.0, 0.10, false}};
-  report = RunGate(baseline, MakeResult(1.15), both, false);
+  report = RunGate(baseline, MakeResult(1.15), both, Allow(false));
   EXPECT_DOUBLE_EQ(report.rows[0].limit, b + 2.0);
   EXPECT_TRUE(report.passed());
-  EXPECT_FALSE(RunGate(baseline, MakeResult(1.25), both, false).passed());
-  // At the limit exactly: pass (current <= limit).
-  v1::JobResult at_limit = baseline;
-  at_limit.mutable_epochs(10)->mutable_components(8)->set_rms(b + 2.0);
-  at_limit.mutable_epochs(10)->mutable_components(8)->set_rms_ci95_high(2 * b);
-  EXPECT_TRUE(RunGate(baseline, at_limit, both, false).passed());
+  EXPECT_FALSE(RunGate(baseline, MakeResult(1.25), both, Allow(false)).passed());
 }
 
 TEST(Gate, LastMatchingRuleDecidesAndSkipRemovesMetrics) {
@@ -414,14 +484,17 @@ TEST(Gate, LastMatchingRuleDecidesAndSkipRemovesMetrics) {
       "rules:\n"
       "  - {metric: 'final.*', rel_tol: 0.1}\n"
       "  - {metric: 'final.yaw_deg.*', rel_tol: 0.6}\n"
-      "  - {metric: 'final.*.*_ci95_*', skip: true}\n");
-  const GateReport report = RunGate(baseline, degraded, rules, false);
+      "  - {metric: 'final.*.p*', skip: true}\n"
+      "  - {metric: 'final.*.abs_mean', skip: true}\n");
+  const GateReport report = RunGate(baseline, degraded, rules, Allow(false));
   for (const GateRow& row : report.rows) {
-    EXPECT_EQ(row.metric.find("ci95"), std::string::npos) << row.metric;
-    // yaw within 60 % (1.5 <= 1.6) passes, everything else at 10 % fails.
-    EXPECT_EQ(row.pass, row.metric.rfind("final.yaw_deg.", 0) == 0) << row.metric;
+    const std::string statistic = row.metric.substr(row.metric.rfind('.') + 1);
+    EXPECT_TRUE(statistic == "std" || statistic == "rms") << row.metric;
+    // Paired, exact ratios: yaw within 60 % (1.5 <= 1.6) passes, everything else at 10 % fails.
+    EXPECT_EQ(row.decision == GateDecision::kRegression, row.metric.rfind("final.yaw_deg.", 0) != 0)
+        << row.metric;
   }
-  EXPECT_EQ(report.rows.size(), 11u * (3 + 5) + 3);
+  EXPECT_EQ(report.rows.size(), 11u * 2);
 }
 
 TEST(Gate, EpochTimeInARuleMayBeWrittenInAnyForm) {
@@ -429,25 +502,68 @@ TEST(Gate, EpochTimeInARuleMayBeWrittenInAnyForm) {
   for (const char* written : {"600", "600.0", "6e2", "6.0E+02"}) {
     const std::string pattern = std::string("epoch[t=") + written + "].velocity_down_m_per_s.std";
     const std::vector<GateRule> rules = ParseGateRules("rules: [{metric: '" + pattern + "'}]");
-    const GateReport report = RunGate(result, result, rules, false);
+    const GateReport report = RunGate(result, result, rules, Allow(false));
     ASSERT_EQ(report.rows.size(), 1u) << written;
     EXPECT_EQ(report.rows[0].metric, "epoch[t=600].velocity_down_m_per_s.std");
   }
 }
 
-TEST(Gate, DifferentJobsAreRefusedUnlessAllowed) {
+TEST(Gate, SeedAndRunCountAreNotPartOfTheJobButTheSensorIs) {
   const v1::JobResult baseline = MakeResult(1.0);
+  // Another seed and run count of the same job: compared, in independent mode.
+  v1::JobResult other_sample = WithSeed(MakeResult(1.0, 80), 7);
+  other_sample.mutable_job()->mutable_monte_carlo()->set_seed(7);
+  other_sample.mutable_job()->mutable_monte_carlo()->set_runs(80);
+  const GateReport sampled = RunGate(baseline, other_sample, DefaultGateRules(), Allow(false));
+  EXPECT_FALSE(sampled.paired);
+  EXPECT_NE(sampled.mode.find("current seed 7 with 80 runs"), std::string::npos) << sampled.mode;
+  // A different rate or sensor model is another job: refused, naming the field.
   v1::JobResult other = MakeResult(1.0);
   other.mutable_job()->set_rate_hz(200);
-  const std::string error = ErrorOf([&] { RunGate(baseline, other, DefaultGateRules(), false); });
-  EXPECT_NE(error.find("job: the current result is of a different job"), std::string::npos)
+  std::string error = ErrorOf([&] { RunGate(baseline, other, DefaultGateRules(), Allow(false)); });
+  EXPECT_EQ(error.rfind("job.rate_hz: differs between the baseline and the current", 0), 0u)
       << error;
   EXPECT_NE(error.find("rate_hz: 100 -> 200"), std::string::npos) << error;
   EXPECT_NE(error.find("--allow-different-job"), std::string::npos) << error;
-  const GateReport report = RunGate(baseline, other, DefaultGateRules(), true);
+  v1::JobResult imu = MakeResult(1.0);
+  imu.mutable_job()->mutable_sensor()->mutable_gyro()->set_arw_deg_per_sqrt_h(0.13);
+  error = ErrorOf([&] { RunGate(baseline, imu, DefaultGateRules(), Allow(false)); });
+  EXPECT_EQ(error.rfind("job.sensor: differs", 0), 0u) << error;
+  const GateReport report = RunGate(baseline, other, DefaultGateRules(), Allow(true));
   EXPECT_TRUE(report.passed());
   ASSERT_FALSE(report.notes.empty());
   EXPECT_NE(report.notes[0].find("different jobs compared"), std::string::npos);
+}
+
+// The result with a filter consistency whose final average NEES over `runs` runs is `final_nees`
+// (9 states; earlier epochs 9).
+v1::JobResult WithNees(v1::JobResult result, double final_nees) {
+  v1::FilterConsistency* consistency = result.mutable_filter_consistency();
+  consistency->set_state_dimension(9);
+  for (int e = 0; e < result.epochs_size(); ++e) {
+    v1::NeesEpoch* nees = consistency->add_epochs();
+    nees->set_t_s(result.epochs(e).t_s());
+    nees->set_runs(result.run_count());
+    nees->set_average_nees(e + 1 == result.epochs_size() ? final_nees : 9.0);
+  }
+  return result;
+}
+
+TEST(Gate, NeesIsTestedWithItsChiSquareDegreesOfFreedom) {
+  // 1000 runs x 9 states: each average is chi2(9000) / 1000, whose ratio of two is F(9000, 9000)
+  // with 95 % interval x/÷ 1.042. 12 / 9 = 1.33 against the limit 1.1 is a regression
+  // (p ~ 1e-40); 9.2 / 9 = 1.022 has its interval's upper end 1.065 within the limit: pass.
+  const std::vector<GateRule> rules = {{"final.nees", 0, 0.1, false}};
+  const v1::JobResult baseline = WithNees(MakeResult(1.0, 1000), 9.0);
+  GateReport report =
+      RunGate(baseline, WithSeed(WithNees(MakeResult(1.0, 1000), 12.0), 7), rules, Allow(false));
+  ASSERT_EQ(report.rows.size(), 1u);
+  EXPECT_EQ(report.rows[0].decision, GateDecision::kRegression);
+  EXPECT_EQ(report.rows[0].test, "F(9000, 9000) NEES ratio (chi2 band)");
+  report =
+      RunGate(baseline, WithSeed(WithNees(MakeResult(1.0, 1000), 9.2), 7), rules, Allow(false));
+  EXPECT_EQ(report.rows[0].decision, GateDecision::kPass);
+  EXPECT_NEAR(report.rows[0].ratio_high, 9.2 / 9.0 * 1.042, 0.002);
 }
 
 TEST(Gate, MetricMissingFromTheCurrentResultFails) {
@@ -456,8 +572,8 @@ TEST(Gate, MetricMissingFromTheCurrentResultFails) {
   fewer.mutable_epochs()->DeleteSubrange(1, 1);  // no epoch at t = 60 s
   fewer.mutable_job()->set_description("x");     // a different job, as it would be
   const std::vector<GateRule> rules = {{"epoch[t=60].*.std", 0, 0.1, false}};
-  const GateReport report = RunGate(baseline, fewer, rules, true);
-  EXPECT_EQ(report.failures, 11);
+  const GateReport report = RunGate(baseline, fewer, rules, Allow(true));
+  EXPECT_EQ(report.regressions, 11);
   EXPECT_EQ(report.rows[0].note, "missing in the current result");
 }
 
@@ -499,16 +615,24 @@ TEST(Gate, RuleErrorsNameTheField) {
   const v1::JobResult result = MakeResult(1.0);
   const std::string typo = ErrorOf([&] {
     RunGate(result, result, ParseGateRules("rules: [{metric: final.*}, {metric: final.yaw.rms}]"),
-            false);
+            Allow(false));
   });
   EXPECT_NE(typo.find("rules[1].metric: \"final.yaw.rms\" is not allowed"), std::string::npos)
       << typo;
+  // Old names point to their replacement.
+  const std::string cep = ErrorOf([&] {
+    RunGate(result, result, ParseGateRules("rules: [{metric: final.*.cep95}]"), Allow(false));
+  });
+  EXPECT_NE(cep.find("use p50, p95, rms"), std::string::npos) << cep;
 }
 
 TEST(Gate, JunitXmlIsValidAndEscaped) {
   const v1::JobResult baseline = MakeResult(1.0, 50, "<b>&\"quoted\"'");
   const v1::JobResult degraded = MakeResult(1.5, 50, "<b>&\"quoted\"'");
-  const GateReport report = RunGate(baseline, degraded, DefaultGateRules(), false);
+  GateReport report = RunGate(baseline, degraded, DefaultGateRules(), Allow(false));
+  report.baseline_file = "base<line>.json";
+  report.current_file = "current.json";
+  ASSERT_GT(report.regressions, 0);
   const std::string xml = RenderJunitXml(report);
   EXPECT_EQ(xml.find("<b>"), std::string::npos);
   EXPECT_NE(xml.find("driftlab gate: &lt;b&gt;&amp;&quot;quoted&quot;&apos;"), std::string::npos);
@@ -525,11 +649,16 @@ TEST(Gate, JunitXmlIsValidAndEscaped) {
       << report.rows.size() << ", len(cases)\n"
       << "failures = r.findall('testcase/failure')\n"
          "assert len(failures) == "
-      << report.failures << ", len(failures)\n"
+      << report.failures() << ", len(failures)\n"
       << "assert int(r.get('failures')) == len(failures)\n"
          "for case in cases:\n"
          "    for failure in case.findall('failure'):\n"
          "        assert failure.get('message').startswith(case.get('name') + ': current')\n"
+         "        assert 'test: ' in failure.text and 'current file current.json' in failure.text\n"
+         "    assert float(case.get('time')) >= 0\n"
+         "p = {q.get('name'): q.get('value') for q in r.findall('properties/property')}\n"
+         "assert p['baseline'] == 'base<line>.json' and p['current'] == 'current.json', p\n"
+         "assert p['mode'].startswith('paired'), p\n"
          "assert r.get('name') == \"\"\"driftlab gate: <b>&\"quoted\"'\"\"\", r.get('name')\n";
   const std::string command =
       "/usr/bin/python3 " + (dir / "check.py").string() + " " + (dir / "junit.xml").string();
@@ -553,8 +682,8 @@ TEST(Gate, DataFileDegradedCopyIsTheBaselineTimesOnePointFive) {
     EXPECT_NEAR(b[i].value, 1.5 * a[i].value, 1e-12 * std::abs(a[i].value)) << a[i].name;
     non_zero += a[i].value != 0 ? 1 : 0;
   }
-  // Only the t = 0 epoch is all zero: 11 x 7 metrics.
-  EXPECT_EQ(non_zero, static_cast<int>(a.size()) - 11 * 7);
+  // Only the t = 0 epoch is all zero: 11 x 3 metrics.
+  EXPECT_EQ(non_zero, static_cast<int>(a.size()) - 11 * 3);
 }
 
 // ---------------------------------------------------------------------------------------------

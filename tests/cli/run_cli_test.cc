@@ -187,7 +187,7 @@ TEST(Gate, ADegradedPresetFailsAgainstTheOriginalsBaselineAndTheOriginalPasses) 
                                    "--allow-different-job", "--junit", file("fail.xml")},
                                   scratch);
   EXPECT_EQ(fail.exit_status, 1) << fail.out << fail.err;
-  EXPECT_NE(fail.out.find("final.horizontal_position_m.cep95"), std::string::npos) << fail.out;
+  EXPECT_NE(fail.out.find("final.horizontal_position_m.p95"), std::string::npos) << fail.out;
   EXPECT_NE(fail.out.find("FAIL"), std::string::npos);
 
   // Both JUnit files are XML that Python's parser reads, with failures only in the second.

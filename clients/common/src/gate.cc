@@ -2,17 +2,14 @@
 
 #include <fmt/format.h>
 #include <google/protobuf/util/message_differencer.h>
-#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
-#include <cstdlib>
-#include <fstream>
 #include <limits>
-#include <sstream>
 #include <unordered_map>
 
-#include "driftlab/input_files.h"
+#include "driftlab/jobspec/gate_statistics.h"
 #include "driftlab/jobspec/result_file.h"
 #include "driftlab/spec_error.h"
 
@@ -23,317 +20,271 @@ namespace {
 std::string TimeText(double t_s) { return fmt::format("{}", t_s); }
 
 // Appends a metric unless it is NaN (sigma of a one-run result: undefined, not gated).
-void Add(std::string name, double value, std::vector<Metric>& out) {
-  if (!std::isnan(value)) out.push_back({std::move(name), value});
+void Add(Metric metric, std::vector<Metric>& out) {
+  if (!std::isnan(metric.value)) out.push_back(std::move(metric));
 }
 
-void AddEpochMetrics(const std::string& prefix, const v1::ComponentStatistics& s,
+std::string UnitOf(int c) { return ComponentUnit(static_cast<v1::ErrorComponent>(c + 1)); }
+
+void AddEpochMetrics(const std::string& prefix, const v1::EpochStatistics& epoch, int e, int c,
                      std::vector<Metric>& out) {
-  Add(prefix + "abs_mean", std::abs(s.mean()), out);
-  Add(prefix + "std", s.std(), out);
-  Add(prefix + "rms", s.rms(), out);
-  Add(prefix + "std_ci95_low", s.std_ci95_low(), out);
-  Add(prefix + "std_ci95_high", s.std_ci95_high(), out);
-  Add(prefix + "rms_ci95_low", s.rms_ci95_low(), out);
-  Add(prefix + "rms_ci95_high", s.rms_ci95_high(), out);
+  const v1::ComponentStatistics& s = epoch.components(c);
+  const std::string unit = UnitOf(c);
+  Add({prefix + "abs_mean", std::abs(s.mean()), MetricKind::kAbsMean, c, e, -1, 0, unit}, out);
+  Add({prefix + "std", s.std(), MetricKind::kStd, c, e, -1, 0, unit}, out);
+  Add({prefix + "rms", s.rms(), MetricKind::kRms, c, e, -1, 0, unit}, out);
 }
 
-void AddCheckpointMetrics(const std::string& prefix, const v1::Checkpoint& checkpoint, int c,
+void AddCheckpointMetrics(const std::string& prefix, const v1::Checkpoint& checkpoint, int k, int c,
                           std::vector<Metric>& out) {
   const v1::ComponentPercentiles& p = checkpoint.components(c);
-  Add(prefix + "p50", p.p50(), out);
-  Add(prefix + "p68", p.p68(), out);
-  Add(prefix + "p95", p.p95(), out);
-  Add(prefix + "p99", p.p99(), out);
-  Add(prefix + "max_abs", p.max_abs(), out);
-  if (c + 1 == v1::HORIZONTAL_POSITION_M) {
-    Add(prefix + "cep50", checkpoint.cep50_m(), out);
-    Add(prefix + "cep95", checkpoint.cep95_m(), out);
-    Add(prefix + "drms2", checkpoint.drms2_m(), out);
-  }
-}
-
-std::string Key(int c) { return ComponentKey(static_cast<v1::ErrorComponent>(c + 1)); }
-
-// Rewrites every "[t=NUMBER]" of a pattern without wildcards inside the brackets to the form
-// ListMetrics prints, so that "epoch[t=600.0]" names "epoch[t=600]".
-std::string NormalizePattern(const std::string& pattern) {
-  std::string out;
-  size_t i = 0;
-  while (i < pattern.size()) {
-    const size_t open = pattern.find("[t=", i);
-    if (open == std::string::npos) break;
-    const size_t close = pattern.find(']', open);
-    if (close == std::string::npos) break;
-    const std::string number = pattern.substr(open + 3, close - open - 3);
-    out += pattern.substr(i, open + 3 - i);
-    char* end = nullptr;
-    const double t_s = std::strtod(number.c_str(), &end);
-    const bool plain = !number.empty() && number.find_first_of("*?") == std::string::npos &&
-                       end == number.c_str() + number.size() && std::isfinite(t_s);
-    out += plain ? TimeText(t_s) : number;
-    out += ']';
-    i = close + 1;
-  }
-  out += pattern.substr(std::min(i, pattern.size()));
-  return out;
-}
-
-std::string ScalarText(const YAML::Node& node) {
-  if (node.IsScalar()) return "\"" + node.Scalar() + "\"";
-  if (node.IsSequence()) return "a list";
-  if (node.IsMap()) return "a mapping";
-  return "null";
-}
-
-// Rejects keys of `node` (a mapping) outside `allowed`; `path` prefixes the field names.
-void CheckKeys(const YAML::Node& node, const std::string& path,
-               const std::vector<std::string>& allowed) {
-  for (const auto& entry : node) {
-    const std::string key = entry.first.Scalar();
-    if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
-      throw SpecError(path + key,
-                      fmt::format("unknown field; allowed: {}", fmt::join(allowed, ", ")), 0);
-    }
-  }
-}
-
-// A tolerance: a finite number in [0, max].
-double ReadTolerance(const YAML::Node& node, const std::string& field, const std::string& name,
-                     double max) {
-  const std::string allowed = fmt::format("0 <= {} <= {}", name, max);
-  double value = 0;
-  try {
-    value = node.as<double>();
-  } catch (const YAML::Exception&) {
-    throw SpecError(field, ScalarText(node), "a number, " + allowed);
-  }
-  if (!(value >= 0 && value <= max)) throw SpecError(field, fmt::format("{}", value), allowed);
-  return value;
-}
-
-constexpr double kMaxAbsTol = 1e12;  // larger than any error of a navigation solution
-constexpr double kMaxRelTol = 100;
-
-struct Tolerances {
-  double abs_tol = 0;
-  double rel_tol = kDefaultRelTol;
-};
-
-void ReadTolerances(const YAML::Node& node, const std::string& path, Tolerances& tolerances) {
-  if (node["abs_tol"]) {
-    tolerances.abs_tol = ReadTolerance(node["abs_tol"], path + "abs_tol", "abs_tol", kMaxAbsTol);
-  }
-  if (node["rel_tol"]) {
-    tolerances.rel_tol = ReadTolerance(node["rel_tol"], path + "rel_tol", "rel_tol", kMaxRelTol);
-  }
-}
-
-std::string EscapeXml(std::string_view text) {
-  std::string out;
-  out.reserve(text.size());
-  for (const char ch : text) {
-    switch (ch) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&apos;";
-        break;
-      case '\t':
-      case '\n':
-      case '\r':
-        out += ch;
-        break;
-      default:
-        // Control characters other than tab and line breaks are not allowed in XML 1.0.
-        out += static_cast<unsigned char>(ch) < 0x20 ? '?' : ch;
-    }
-  }
-  return out;
+  const std::string unit = UnitOf(c);
+  Add({prefix + "p50", p.p50(), MetricKind::kQuantile, c, -1, k, 0.50, unit}, out);
+  Add({prefix + "p68", p.p68(), MetricKind::kQuantile, c, -1, k, 0.68, unit}, out);
+  Add({prefix + "p95", p.p95(), MetricKind::kQuantile, c, -1, k, 0.95, unit}, out);
+  Add({prefix + "p99", p.p99(), MetricKind::kQuantile, c, -1, k, 0.99, unit}, out);
 }
 
 std::string Number(double value) { return fmt::format("{:.6g}", value); }
 
-// First line of the differences between two jobs, shortened for a one-line error.
-std::string FirstDifference(const v1::Job& baseline, const v1::Job& current) {
+std::string Key(int c) { return ComponentKey(static_cast<v1::ErrorComponent>(c + 1)); }
+
+// The job's identity for the gate: the echo without monte_carlo.runs and monte_carlo.seed (a
+// different sample of the same job, which the tests account for).
+v1::Job Identity(const v1::Job& job) {
+  v1::Job identity = job;
+  identity.mutable_monte_carlo()->clear_runs();
+  identity.mutable_monte_carlo()->clear_seed();
+  return identity;
+}
+
+// The first difference between two jobs: its field path ("sensor.gyro.arw_deg_per_sqrt_h") and
+// the differencer's line ("modified: sensor.gyro...: 0.1 -> 0.13"), shortened for one line.
+std::pair<std::string, std::string> FirstDifference(const v1::Job& baseline,
+                                                    const v1::Job& current) {
   google::protobuf::util::MessageDifferencer differencer;
   std::string report;
   differencer.ReportDifferencesToString(&report);
   differencer.Compare(baseline, current);
   std::string line = report.substr(0, report.find('\n'));
-  if (line.size() > 160) line = line.substr(0, 157) + "...";
-  return line;
+  std::string path = line;
+  const size_t space = path.find(": ");
+  if (space != std::string::npos) path = path.substr(space + 2);
+  path = path.substr(0, path.find(':'));
+  if (line.size() > 200) {
+    line.resize(197);
+    line.append("...");
+  }
+  return {path, line};
+}
+
+double Seconds(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// Values of component c of every run at checkpoint k: |error| for quantiles (signed components)
+// or the signed error (moments). Empty when the file keeps no per-run values there.
+std::vector<double> RunValues(const v1::JobResult& result, int k, int c, bool absolute) {
+  std::vector<double> values;
+  if (k < 0) return values;
+  const v1::Checkpoint& checkpoint = result.checkpoints(k);
+  values.reserve(checkpoint.runs_size());
+  for (const v1::RunValues& run : checkpoint.runs()) {
+    values.push_back(absolute ? std::abs(run.values(c)) : run.values(c));
+  }
+  return values;
+}
+
+// Index of the checkpoint at t_s, or -1.
+int CheckpointAt(const v1::JobResult& result, double t_s) {
+  for (int k = 0; k < result.checkpoints_size(); ++k) {
+    if (result.checkpoints(k).t_s() == t_s) return k;
+  }
+  return -1;
+}
+
+// Paired when both files hold the same runs of the same seed with per-run values kept: then run
+// r of both drew the same random numbers (DESIGN.md invariant 3) as long as the random streams
+// did not change, and the paired tests stay valid (if weaker) even when they did.
+bool SameRuns(const v1::JobResult& baseline, const v1::JobResult& current) {
+  if (baseline.seed() != current.seed() || baseline.first_run() != current.first_run() ||
+      baseline.run_count() != current.run_count() || baseline.run_count() < 3) {
+    return false;
+  }
+  const v1::Checkpoint& b = *baseline.checkpoints().rbegin();
+  const v1::Checkpoint& c = *current.checkpoints().rbegin();
+  return b.runs_size() == static_cast<int>(baseline.run_count()) &&
+         c.runs_size() == static_cast<int>(current.run_count());
+}
+
+// Runs the test of one metric present in both results.
+TestOutcome TestMetric(const v1::JobResult& baseline, const Metric& mb,
+                       const v1::JobResult& current, const Metric& mc, double limit_ratio,
+                       bool paired, double alpha) {
+  const double n_b = baseline.run_count(), n_c = current.run_count();
+  if (mb.kind == MetricKind::kQuantile) {
+    std::vector<double> xb = RunValues(baseline, mb.checkpoint, mb.component, true);
+    std::vector<double> xc = RunValues(current, mc.checkpoint, mc.component, true);
+    if (xb.empty() || xc.empty()) {
+      TestOutcome none;
+      none.ratio = mc.value / mb.value;
+      none.ratio_low = 0;
+      none.ratio_high = std::numeric_limits<double>::infinity();
+      none.test = "none: per-run values not kept";
+      return none;
+    }
+    // The bootstrap costs B x n per metric; above kMaxBootstrapRuns the order-statistic bounds
+    // (valid for paired samples too) are tight enough and far cheaper.
+    if (paired && xb.size() == xc.size() && xb.size() >= 3 && xb.size() <= kMaxBootstrapRuns) {
+      TestOutcome out = TestQuantilePaired(xb, xc, mb.quantile, limit_ratio, alpha);
+      out.ratio = mc.value / mb.value;
+      return out;
+    }
+    TestOutcome out = TestQuantile(std::move(xb), std::move(xc), mb.quantile, limit_ratio, alpha);
+    out.ratio = mc.value / mb.value;  // the files' own percentiles
+    return out;
+  }
+  if (mb.kind == MetricKind::kNees) {
+    const double dof = baseline.filter_consistency().state_dimension();
+    const double runs_b = baseline.filter_consistency().epochs(mb.epoch).runs();
+    const double runs_c = current.filter_consistency().epochs(mc.epoch).runs();
+    return TestNees(mb.value, dof * runs_b, mc.value, dof * runs_c, limit_ratio, alpha);
+  }
+  if (mb.kind != MetricKind::kRms && (n_b < 2 || n_c < 2)) {
+    TestOutcome none;
+    none.ratio = mc.value / mb.value;
+    none.ratio_high = std::numeric_limits<double>::infinity();
+    none.test = "none: one run has no sigma";
+    return none;
+  }
+  // Moments: paired on the per-run values of the checkpoint at the epoch's time, when there is
+  // one; else from the files' moments.
+  if (paired) {
+    const double t_s = baseline.epochs(mb.epoch).t_s();
+    const std::vector<double> x =
+        RunValues(baseline, CheckpointAt(baseline, t_s), mb.component, false);
+    const std::vector<double> y =
+        RunValues(current, CheckpointAt(current, t_s), mc.component, false);
+    if (x.size() >= 3 && x.size() == y.size()) {
+      switch (mb.kind) {
+        case MetricKind::kStd:
+          return TestSigmaPaired(x, y, limit_ratio, alpha);
+        case MetricKind::kRms:
+          return TestRmsPaired(x, y, limit_ratio, alpha);
+        default:
+          return TestAbsMeanPaired(x, y, limit_ratio, alpha);
+      }
+    }
+  }
+  const v1::ComponentStatistics& sb = baseline.epochs(mb.epoch).components(mb.component);
+  const v1::ComponentStatistics& sc = current.epochs(mc.epoch).components(mc.component);
+  switch (mb.kind) {
+    case MetricKind::kStd:
+      return TestSigmaIndependent(sb.std(), n_b, sc.std(), n_c, limit_ratio, alpha);
+    case MetricKind::kRms:
+      return TestRmsIndependent(sb.rms(), n_b, sc.rms(), n_c, limit_ratio, alpha);
+    default:
+      return TestAbsMeanWelch(sb.mean(), sb.std(), n_b, sc.mean(), sc.std(), n_c, limit_ratio,
+                              alpha);
+  }
 }
 
 }  // namespace
 
 std::vector<Metric> ListMetrics(const v1::JobResult& result) {
   std::vector<Metric> metrics;
-  const v1::EpochStatistics& final_epoch = *result.epochs().rbegin();
-  const v1::Checkpoint& final_checkpoint = *result.checkpoints().rbegin();
+  const int final_e = result.epochs_size() - 1;
+  const int final_k = result.checkpoints_size() - 1;
   for (int c = 0; c < kErrorComponentCount; ++c) {
     const std::string prefix = "final." + Key(c) + ".";
-    AddEpochMetrics(prefix, final_epoch.components(c), metrics);
-    AddCheckpointMetrics(prefix, final_checkpoint, c, metrics);
+    AddEpochMetrics(prefix, result.epochs(final_e), final_e, c, metrics);
+    AddCheckpointMetrics(prefix, result.checkpoints(final_k), final_k, c, metrics);
   }
-  for (const v1::EpochStatistics& epoch : result.epochs()) {
-    const std::string selector = "epoch[t=" + TimeText(epoch.t_s()) + "].";
-    for (int c = 0; c < kErrorComponentCount; ++c) {
-      AddEpochMetrics(selector + Key(c) + ".", epoch.components(c), metrics);
+  const v1::FilterConsistency& consistency = result.filter_consistency();
+  if (consistency.epochs_size() == result.epochs_size() && consistency.state_dimension() > 0) {
+    const v1::NeesEpoch& nees = consistency.epochs(final_e);
+    if (nees.runs() > 0 && nees.has_average_nees()) {
+      Add({"final.nees", nees.average_nees(), MetricKind::kNees, -1, final_e, -1, 0, ""}, metrics);
     }
   }
-  for (const v1::Checkpoint& checkpoint : result.checkpoints()) {
-    const std::string selector = "checkpoint[t=" + TimeText(checkpoint.t_s()) + "].";
+  for (int e = 0; e < result.epochs_size(); ++e) {
+    const std::string selector = "epoch[t=" + TimeText(result.epochs(e).t_s()) + "].";
     for (int c = 0; c < kErrorComponentCount; ++c) {
-      AddCheckpointMetrics(selector + Key(c) + ".", checkpoint, c, metrics);
+      AddEpochMetrics(selector + Key(c) + ".", result.epochs(e), e, c, metrics);
+    }
+  }
+  for (int k = 0; k < result.checkpoints_size(); ++k) {
+    const std::string selector = "checkpoint[t=" + TimeText(result.checkpoints(k).t_s()) + "].";
+    for (int c = 0; c < kErrorComponentCount; ++c) {
+      AddCheckpointMetrics(selector + Key(c) + ".", result.checkpoints(k), k, c, metrics);
     }
   }
   return metrics;
 }
 
-std::vector<GateRule> DefaultGateRules() {
-  return {{"final.*", 0, kDefaultRelTol, false},
-          {"final.*.p95", 0, kDefaultRelTolP95, false},
-          {"final.*.cep95", 0, kDefaultRelTolP95, false},
-          {"final.*.p99", 0, kDefaultRelTolP99, false},
-          {"final.*.max_abs", 0, kDefaultRelTolMax, false},
-          {"final.*.abs_mean", 0, 0, true},
-          {"final.*.*_ci95_*", 0, 0, true}};
+const char* DecisionName(GateDecision decision) {
+  switch (decision) {
+    case GateDecision::kPass:
+      return "pass";
+    case GateDecision::kImproved:
+      return "improved";
+    case GateDecision::kRegression:
+      return "regression";
+    default:
+      return "inconclusive";
+  }
 }
 
-bool MetricMatches(std::string_view pattern, std::string_view name) {
-  // Iterative glob match with backtracking to the last '*' (linear in practice).
-  size_t p = 0, n = 0, star = std::string_view::npos, resume = 0;
-  while (n < name.size()) {
-    if (p < pattern.size() && (pattern[p] == '?' || pattern[p] == name[n])) {
-      ++p;
-      ++n;
-    } else if (p < pattern.size() && pattern[p] == '*') {
-      star = p++;
-      resume = n;
-    } else if (star != std::string_view::npos) {
-      p = star + 1;
-      n = ++resume;
-    } else {
-      return false;
-    }
-  }
-  while (p < pattern.size() && pattern[p] == '*') ++p;
-  return p == pattern.size();
-}
-
-std::vector<GateRule> ParseGateRules(std::string_view text, std::string_view source) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(std::string(text));
-  } catch (const YAML::Exception& e) {
-    throw SpecError(std::string(source),
-                    fmt::format("invalid YAML/JSON at line {}: {}", e.mark.line + 1, e.msg), 0);
-  }
-  if (!root.IsMap()) {
-    throw SpecError(std::string(source), ScalarText(root),
-                    "a mapping with `rules` (and optional `defaults`)");
-  }
-  CheckKeys(root, "", {"defaults", "rules"});
-  Tolerances defaults;
-  if (root["defaults"]) {
-    if (!root["defaults"].IsMap()) {
-      throw SpecError("defaults", ScalarText(root["defaults"]), "a mapping {abs_tol, rel_tol}");
-    }
-    CheckKeys(root["defaults"], "defaults.", {"abs_tol", "rel_tol"});
-    ReadTolerances(root["defaults"], "defaults.", defaults);
-  }
-  const YAML::Node list = root["rules"];
-  if (!list || !list.IsSequence() || list.size() == 0) {
-    throw SpecError("rules",
-                    !list               ? ""
-                    : list.IsSequence() ? "an empty list"
-                                        : ScalarText(list),
-                    "a non-empty list of {metric, abs_tol, rel_tol, skip}");
-  }
-  std::vector<GateRule> rules;
-  for (size_t i = 0; i < list.size(); ++i) {
-    const YAML::Node& item = list[i];
-    const std::string path = fmt::format("rules[{}].", i);
-    if (!item.IsMap()) {
-      throw SpecError(fmt::format("rules[{}]", i), ScalarText(item),
-                      "a mapping {metric, abs_tol, rel_tol, skip}");
-    }
-    CheckKeys(item, path, {"metric", "abs_tol", "rel_tol", "skip"});
-    const YAML::Node metric = item["metric"];
-    if (!metric || !metric.IsScalar() || metric.Scalar().empty()) {
-      throw SpecError(path + "metric", metric ? ScalarText(metric) : "",
-                      "a metric name or glob, e.g. \"final.*.cep95\"");
-    }
-    Tolerances tolerances = defaults;
-    ReadTolerances(item, path, tolerances);
-    bool skip = false;
-    if (item["skip"]) {
-      try {
-        skip = item["skip"].as<bool>();
-      } catch (const YAML::Exception&) {
-        throw SpecError(path + "skip", ScalarText(item["skip"]), "true or false");
-      }
-    }
-    rules.push_back(
-        {NormalizePattern(metric.Scalar()), tolerances.abs_tol, tolerances.rel_tol, skip});
-  }
-  return rules;
-}
-
-std::vector<GateRule> LoadGateRules(const std::filesystem::path& path) {
-  const std::string name = path.string();
-  const std::string text = ReadInputFile(path, kMaxSmallTextFileBytes, name);
-  try {
-    return ParseGateRules(text, name);
-  } catch (const SpecError& e) {
-    if (e.field() == name) throw;
-    throw SpecError(name, e.what(), 0);
-  }
+long RunsForSigmaChange(double true_ratio, double rel_tol, double alpha, int metrics) {
+  return RunsToDetectSigmaRatio(true_ratio, 1.0 + rel_tol, alpha / std::max(metrics, 1), 0.9);
 }
 
 GateReport RunGate(const v1::JobResult& baseline, const v1::JobResult& current,
-                   const std::vector<GateRule>& rules, bool allow_different_job) {
+                   const std::vector<GateRule>& rules, const GateOptions& options) {
+  if (!(options.alpha > 0 && options.alpha < 1)) {
+    throw SpecError("--alpha", fmt::format("{}", options.alpha), "0 < alpha < 1");
+  }
   GateReport report;
+  report.options = options;
   report.job_name = baseline.job().name();
-  if (!google::protobuf::util::MessageDifferencer::Equals(baseline.job(), current.job())) {
-    const std::string difference = FirstDifference(baseline.job(), current.job());
-    if (!allow_different_job) {
-      throw SpecError("job",
-                      fmt::format("the current result is of a different job than the baseline "
-                                  "({}); results of different jobs are not comparable; pass "
-                                  "--allow-different-job to compare them anyway",
-                                  difference),
+  report.baseline_runs = baseline.run_count();
+  report.current_runs = current.run_count();
+  const v1::Job baseline_job = Identity(baseline.job()), current_job = Identity(current.job());
+  if (!google::protobuf::util::MessageDifferencer::Equals(baseline_job, current_job)) {
+    const auto [path, line] = FirstDifference(baseline_job, current_job);
+    if (!options.allow_different_job) {
+      throw SpecError("job." + path,
+                      fmt::format("differs between the baseline and the current result ({}): "
+                                  "they are different jobs (motion, sensor model, navigation or "
+                                  "output settings), not comparable; seed and run count may "
+                                  "differ; pass --allow-different-job to compare them anyway",
+                                  line),
                       0);
     }
-    report.notes.push_back("different jobs compared (--allow-different-job): " + difference);
+    report.notes.push_back("different jobs compared (--allow-different-job): " + line);
   }
   if (baseline.engine_version() != current.engine_version()) {
     report.notes.push_back(fmt::format("engine versions differ: baseline {}, current {}",
                                        baseline.engine_version(), current.engine_version()));
   }
-  if (baseline.seed() != current.seed() || baseline.run_count() != current.run_count()) {
-    report.notes.push_back(fmt::format(
-        "different samples: baseline seed {} with {} runs, current seed {} with {} runs",
-        baseline.seed(), baseline.run_count(), current.seed(), current.run_count()));
-  }
+  report.paired = SameRuns(baseline, current);
+  report.mode =
+      report.paired
+          ? fmt::format(
+                "paired: same seed {} and runs [{}, {}) in both files; "
+                "tests on the per-run differences",
+                baseline.seed(), baseline.first_run(), baseline.first_run() + baseline.run_count())
+          : fmt::format(
+                "independent: baseline seed {} with {} runs, current seed {} "
+                "with {} runs; two-sample tests",
+                baseline.seed(), baseline.run_count(), current.seed(), current.run_count());
 
   const std::vector<Metric> baseline_metrics = ListMetrics(baseline);
-  std::unordered_map<std::string, double> current_values;
-  for (Metric& metric : ListMetrics(current)) {
-    current_values.emplace(std::move(metric.name), metric.value);
-  }
+  std::vector<Metric> current_list = ListMetrics(current);
+  std::unordered_map<std::string, const Metric*> current_metrics;
+  for (const Metric& metric : current_list) current_metrics.emplace(metric.name, &metric);
   std::vector<bool> rule_used(rules.size(), false);
+  std::vector<size_t> tested;  // rows with a p-value, for Holm
   for (const Metric& metric : baseline_metrics) {
     // The last matching rule decides.
     const GateRule* rule = nullptr;
@@ -344,81 +295,86 @@ GateReport RunGate(const v1::JobResult& baseline, const v1::JobResult& current,
       }
     }
     if (!rule || rule->skip) continue;
+    const auto start = std::chrono::steady_clock::now();
     GateRow row;
     row.metric = metric.name;
+    row.unit = metric.unit;
     row.baseline = metric.value;
     // Errors: larger is worse, so only an increase beyond the tolerance is a regression.
     row.limit = metric.value + std::max(rule->abs_tol, rule->rel_tol * std::abs(metric.value));
-    const auto found = current_values.find(metric.name);
-    if (found == current_values.end()) {
+    const auto found = current_metrics.find(metric.name);
+    if (found == current_metrics.end()) {
       row.current = std::numeric_limits<double>::quiet_NaN();
+      row.ratio = row.ratio_low = row.ratio_high = row.current;
+      row.decision = GateDecision::kRegression;
+      row.test = "none";
       row.note = "missing in the current result";
+    } else if (!(metric.value > 0)) {
+      // A zero baseline (an error-free component) has no ratio: the value itself is compared.
+      row.current = found->second->value;
+      row.ratio = row.ratio_low = row.ratio_high = std::numeric_limits<double>::quiet_NaN();
+      row.test = "exact (baseline 0)";
+      row.p_value = row.current > row.limit ? 0.0 : 1.0;
+      tested.push_back(report.rows.size());
     } else {
-      row.current = found->second;
-      row.pass = row.current <= row.limit;
-      if (!row.pass) {
-        row.note = fmt::format("current {} > limit {} (baseline {})", Number(row.current),
-                               Number(row.limit), Number(row.baseline));
-      }
+      row.current = found->second->value;
+      const double limit_ratio = row.limit / metric.value;
+      const TestOutcome outcome = TestMetric(baseline, metric, current, *found->second, limit_ratio,
+                                             report.paired, options.alpha);
+      row.ratio = outcome.ratio;
+      row.ratio_low = outcome.ratio_low;
+      row.ratio_high = outcome.ratio_high;
+      row.p_value = outcome.p_value;
+      row.test = outcome.test;
+      tested.push_back(report.rows.size());
     }
-    report.failures += row.pass ? 0 : 1;
+    row.wall_s = Seconds(start);
     report.rows.push_back(std::move(row));
   }
   for (size_t r = 0; r < rules.size(); ++r) {
     if (!rule_used[r]) {
       throw SpecError(fmt::format("rules[{}].metric", r), "\"" + rules[r].metric + "\"",
                       "a name or glob matching at least one metric of the baseline (list them "
-                      "with `driftlab gate BASELINE --list-metrics`)");
+                      "with `driftlab gate BASELINE --list-metrics`; cep50, cep95, drms2, "
+                      "max_abs and the *_ci95_* bounds are no metrics: use p50, p95, rms)");
     }
+  }
+
+  // Holm over every tested metric; then the interval decides between pass, improved and
+  // inconclusive.
+  std::vector<double> p_values;
+  for (const size_t i : tested) p_values.push_back(report.rows[i].p_value);
+  const std::vector<bool> rejected = HolmReject(p_values, options.alpha);
+  for (size_t t = 0; t < tested.size(); ++t) {
+    GateRow& row = report.rows[tested[t]];
+    const double limit_ratio = row.limit / row.baseline;
+    if (rejected[t]) {
+      row.decision = GateDecision::kRegression;
+      row.note =
+          fmt::format("current {} > limit {} (baseline {}), p = {:.2g} ({})", Number(row.current),
+                      Number(row.limit), Number(row.baseline), row.p_value, row.test);
+    } else if (std::isnan(row.ratio)) {
+      row.decision = GateDecision::kPass;  // exact comparison within the limit
+    } else if (row.ratio_high < 1.0) {
+      row.decision = GateDecision::kImproved;
+    } else if (row.ratio_high <= limit_ratio) {
+      row.decision = GateDecision::kPass;
+    } else {
+      row.decision = GateDecision::kInconclusive;
+      row.note = fmt::format("interval of current/baseline [{}, {}] straddles the limit {}",
+                             Number(row.ratio_low), Number(row.ratio_high), Number(limit_ratio));
+    }
+  }
+  for (const GateRow& row : report.rows) {
+    report.regressions += row.decision == GateDecision::kRegression ? 1 : 0;
+    report.inconclusive += row.decision == GateDecision::kInconclusive ? 1 : 0;
+  }
+  const double m = static_cast<double>(std::max<size_t>(tested.size(), 1));
+  if (baseline.run_count() >= 2 && current.run_count() >= 2) {
+    report.detectable_sigma_ratio = DetectableSigmaRatio(
+        baseline.run_count(), current.run_count(), 1.0 + kDefaultRelTol, options.alpha / m, 0.9);
   }
   return report;
-}
-
-std::string FormatGateTable(const GateReport& report) {
-  size_t width = std::string_view("metric").size();
-  for (const GateRow& row : report.rows) width = std::max(width, row.metric.size());
-  std::string out;
-  for (const std::string& note : report.notes) out += "note: " + note + "\n";
-  out += fmt::format("{:<{}}  {:>12}  {:>12}  {:>12}  {}\n", "metric", width, "baseline", "current",
-                     "limit", "result");
-  std::vector<std::string> failed;
-  for (const GateRow& row : report.rows) {
-    out +=
-        fmt::format("{:<{}}  {:>12}  {:>12}  {:>12}  {}\n", row.metric, width, Number(row.baseline),
-                    Number(row.current), Number(row.limit), row.pass ? "PASS" : "FAIL");
-    if (!row.pass) failed.push_back(row.metric);
-  }
-  if (report.passed()) {
-    out += fmt::format("gate: PASS, {} metrics compared, no regression\n", report.rows.size());
-  } else {
-    out += fmt::format("gate: FAIL, {} of {} metrics regressed: {}\n", report.failures,
-                       report.rows.size(), fmt::join(failed, ", "));
-  }
-  return out;
-}
-
-std::string RenderJunitXml(const GateReport& report) {
-  std::string out = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
-  out += fmt::format(
-      "<testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"0\" skipped=\"0\" "
-      "time=\"0\">\n",
-      EscapeXml("driftlab gate: " + report.job_name), report.rows.size(), report.failures);
-  for (const GateRow& row : report.rows) {
-    const std::string detail =
-        fmt::format("baseline {}, current {}, limit {}", Number(row.baseline), Number(row.current),
-                    Number(row.limit));
-    out += fmt::format("  <testcase classname=\"driftlab.gate\" name=\"{}\" time=\"0\"",
-                       EscapeXml(row.metric));
-    if (row.pass) {
-      out += fmt::format(">\n    <system-out>{}</system-out>\n  </testcase>\n", EscapeXml(detail));
-    } else {
-      out += fmt::format(
-          ">\n    <failure message=\"{}\" type=\"regression\">{}</failure>\n  </testcase>\n",
-          EscapeXml(row.metric + ": " + row.note), EscapeXml(detail));
-    }
-  }
-  out += "</testsuite>\n";
-  return out;
 }
 
 }  // namespace driftlab::jobspec
