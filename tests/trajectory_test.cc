@@ -369,6 +369,27 @@ TEST(TrajectoryGenerator, GnssInsSimCommandEndsEarlyOnceConvergedOrAtItsMaximumT
   EXPECT_NEAR(t.last.v_eb_n.x(), 1.0 + 0.09 * (1.0 - std::pow(0.9, 99.0)), 1e-12);
 }
 
+TEST(TrajectoryGenerator, GnssInsSimGpsVisibilityZeroMarksTheTimesOfThoseCommands) {
+  // 10 s visible, 5 s + 5 s invisible (merged), 3 s visible, 2 s invisible at the end: windows
+  // [10, 20) and [23, 24.99] (the output ends one step before the executor's last).
+  MotionSpec m = Motion(EarthModel::kFlat, 30.0, Vector3d::Zero(), 0.0);
+  auto hold = [](double duration_s, bool visible) {
+    GnssInsSimCommand c;
+    c.duration_s = duration_s;
+    c.gps_visible = visible;
+    return c;
+  };
+  m.segments = {hold(10, true), hold(5, false), hold(5, false), hold(3, true), hold(2, false)};
+  const TrajectoryGenerator g(m, 100.0);
+  ASSERT_EQ(g.gps_invisible_s().size(), 2u);
+  // Tolerance: k dt with dt = 1 / 100 rounds by 1 ulp of the time, < 1e-12 s.
+  EXPECT_NEAR(g.gps_invisible_s()[0].first, 10.0, 1e-12);
+  EXPECT_NEAR(g.gps_invisible_s()[0].second, 20.0, 1e-12);
+  EXPECT_NEAR(g.gps_invisible_s()[1].first, 23.0, 1e-12);
+  EXPECT_NEAR(g.gps_invisible_s()[1].second, 24.99, 1e-12);
+  EXPECT_EQ(g.gps_invisible_s()[1].second, g.duration_s());
+}
+
 TEST(TrajectoryGenerator, GnssInsSimType1HugeRateIsRefusedNamingTheLimit) {
   MotionSpec m = Motion(EarthModel::kWgs84, 30.0, Vector3d::Zero(), 0.0);
   GnssInsSimCommand c;

@@ -270,8 +270,12 @@ struct PlanState {
 class Planner {
  public:
   Planner(const MotionSpec& motion, const NavEnvironment& env, double rate_hz,
-          std::vector<Piece>* pieces)
-      : motion_(motion), pieces_(pieces), rate_hz_(rate_hz), dt_s_(1.0 / rate_hz) {
+          std::vector<Piece>* pieces, std::vector<std::pair<double, double>>* gps_invisible_s)
+      : motion_(motion),
+        pieces_(pieces),
+        gps_invisible_s_(gps_invisible_s),
+        rate_hz_(rate_hz),
+        dt_s_(1.0 / rate_hz) {
     g_m_per_s2_ = env.Gravity(motion.initial.llh.lat_rad, motion.initial.llh.h_m).norm();
     state_.euler = motion.initial.attitude;
     state_.v_eb_n = motion.initial.v_eb_n;
@@ -898,6 +902,7 @@ class Planner {
     const Vector3d v_com_b = absolute_velocity ? cmd.v_b : Vector3d(x.v_b + cmd.v_b);
     Vector3d v_filt = x.v_b;
     bool complete = false;
+    const int64_t first_step = x.steps;
     for (int64_t n = 0; n < max_steps && !complete; ++n) {
       if (cmd.type == 1) {
         x.att_dot = a * x.att_dot + b * cmd.euler_ypr;
@@ -916,6 +921,15 @@ class Planner {
     if (complete) {
       x.att_dot.setZero();
       x.v_dot_b.setZero();
+    }
+    if (!cmd.gps_visible && x.steps > first_step) {  // its GPS epochs are those of its steps
+      const double start_s = x.t_start + static_cast<double>(first_step) * dt_s_;
+      const double end_s = x.t_start + static_cast<double>(x.steps) * dt_s_;
+      if (!gps_invisible_s_->empty() && gps_invisible_s_->back().second >= start_s) {
+        gps_invisible_s_->back().second = end_s;
+      } else {
+        gps_invisible_s_->emplace_back(start_s, end_s);
+      }
     }
     if (!(x.v_b.norm() <= kMaxSpeed_m_per_s)) {
       Reject(field(cmd.type == 1 ? "vx_body" : "duration_s"), x.v_b.norm(),
@@ -945,6 +959,7 @@ class Planner {
 
   const MotionSpec& motion_;
   std::vector<Piece>* pieces_;
+  std::vector<std::pair<double, double>>* gps_invisible_s_;
   PlanState state_;
   Executor exec_;
   double rate_hz_ = 1.0;
@@ -1187,6 +1202,7 @@ struct TrajectoryGenerator::Impl {
   int64_t step = 0;
   std::vector<Piece> pieces;
   std::vector<double> breakpoints;
+  std::vector<std::pair<double, double>> gps_invisible_s;
   NavState initial;
   ImuSample initial_sample;
   // Integration state at t = step / rate_hz: (L, lambda, h) as an unevaluated sum llh + llh_lo.
@@ -1326,7 +1342,7 @@ TrajectoryGenerator::TrajectoryGenerator(const MotionSpec& motion, double rate_h
     m.env = NavEnvironment::Wgs84();
   }
   if (motion.truth_profile.empty()) {
-    Planner planner(motion, m.env, rate_hz, &m.pieces);
+    Planner planner(motion, m.env, rate_hz, &m.pieces, &m.gps_invisible_s);
     planner.Plan();
     m.duration_s = planner.duration();
   } else {
@@ -1348,6 +1364,12 @@ TrajectoryGenerator::TrajectoryGenerator(const MotionSpec& motion, double rate_h
            "a total duration of at least one output interval, 1 / rate_hz = " + Num(m.dt_s) + " s");
   }
   for (size_t i = 1; i < m.pieces.size(); ++i) m.breakpoints.push_back(m.pieces[i].t0);
+  while (!m.gps_invisible_s.empty() && m.gps_invisible_s.back().first >= m.duration_s) {
+    m.gps_invisible_s.pop_back();  // only the dropped last step
+  }
+  if (!m.gps_invisible_s.empty()) {
+    m.gps_invisible_s.back().second = std::min(m.gps_invisible_s.back().second, m.duration_s);
+  }
 
   m.llh = Vector3d(start_llh.lat_rad, start_llh.lon_rad, start_llh.h_m);
   const Kinematics k0 = m.pieces.front().Evaluate(0.0);
@@ -1383,6 +1405,9 @@ int64_t TrajectoryGenerator::num_steps() const { return impl_->num_steps; }
 const NavState& TrajectoryGenerator::initial_state() const { return impl_->initial; }
 const ImuSample& TrajectoryGenerator::initial_sample() const { return impl_->initial_sample; }
 const std::vector<double>& TrajectoryGenerator::breakpoints_s() const { return impl_->breakpoints; }
+const std::vector<std::pair<double, double>>& TrajectoryGenerator::gps_invisible_s() const {
+  return impl_->gps_invisible_s;
+}
 int64_t TrajectoryGenerator::step() const { return impl_->step; }
 
 bool TrajectoryGenerator::IsStaticAt(double t_s) const {

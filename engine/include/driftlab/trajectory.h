@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -231,6 +232,10 @@ class TrajectoryGenerator {
   // Times at which the kinematics have a kink (segment boundaries, ramp ends), sorted; interior
   // times only (0 and the end are not listed).
   const std::vector<double>& breakpoints_s() const;
+  // Time windows [start_s, end_s) of the gnss-ins-sim commands whose GPS-visibility column is 0
+  // (the times of their executor steps), ascending and merged, clipped to the duration; empty for
+  // other motions. A job with GNSS aiding turns them into outages.
+  const std::vector<std::pair<double, double>>& gps_invisible_s() const;
   // True while the vehicle is static (speed and angular rate w.r.t. the Earth both exactly zero) at
   // t, in [0, duration]; left-continuous like the point samples (true at the end time of a static
   // segment).
