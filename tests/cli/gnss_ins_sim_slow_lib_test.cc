@@ -5,9 +5,8 @@
 // (github.com/Aceinna/gnss-ins-sim commit 966ff271bf21d08fbd0e31d1eb47fa5f3acef8d3, Debian
 // python3-numpy 1.24.2 / python3-scipy 1.10.1): Sim([100, 0, 0], motion_def-static.csv,
 // ref_frame=1, imu=IMU('mid-accuracy', axis=6)), algorithm demo_algorithms/free_integration.py,
-// sim.run(20), sample standard deviation (ddof 1) of the 20 runs' errors at the last sample
-// (bench/gnss_ins_sim_compare.py computes the same; 20 runs because the shared machine did not
-// give gnss-ins-sim's 200 runs the CPU time before the deadline).
+// sim.run(200), sample standard deviation (ddof 1) of the 200 runs' errors at the last sample
+// (bench/gnss_ins_sim_compare.py computes the same).
 #include <gtest/gtest.h>
 
 #include <array>
@@ -35,14 +34,14 @@ TEST(GnssInsSimStatistics, StaticMidAccuracyFinalSigmasInsideTheFTestIntervalOfI
   const v1::EpochStatistics& final_epoch = result.epochs(result.epochs_size() - 1);
   // gnss-ins-sim's last sample is at 499.99 s (50000 samples at 100 Hz).
   EXPECT_NEAR(final_epoch.t_s(), 499.99, 1e-9);
-  // N, E, D [m]; v_N, v_E, v_D [m/s]; roll, pitch, yaw [deg] (gnss-ins-sim, 20 runs).
+  // N, E, D [m]; v_N, v_E, v_D [m/s]; roll, pitch, yaw [deg] (gnss-ins-sim, 200 runs).
   constexpr std::array<double, 9> kGnssInsSimSigma = {
-      1.73816523e+03, 1.96746321e+03, 5.82751950e+00, 1.02223358e+01, 1.05619647e+01,
-      3.06165111e-02, 2.40213477e-01, 2.85315614e-01, 3.61575201e-01};
-  // Equal variances: (s_driftlab / s_gnss-ins-sim)^2 ~ F(199, 19). Two-sided 95 % family-wise
+      2.041013568e+03, 2.187302025e+03, 7.071179799e+00, 1.200666678e+01, 1.268745534e+01,
+      4.573077719e-02, 3.354270551e-01, 2.791548993e-01, 3.395820476e-01};
+  // Equal variances: (s_driftlab / s_gnss-ins-sim)^2 ~ F(199, 199). Two-sided 95 % family-wise
   // over the 9 components (Bonferroni, 0.05 / 9 each): F quantiles 0.00278 and 0.99722 of
-  // F(199, 19) = 0.44201 and 3.11386 (scipy.stats.f.ppf).
-  constexpr double kLow = 0.44201347, kHigh = 3.11385633;
+  // F(199, 199) = 0.67375 and 1.48423 (scipy.stats.f.ppf).
+  constexpr double kLow = 0.67374823, kHigh = 1.48423396;
   for (int i = 0; i < 9; ++i) {
     const double s = final_epoch.components(i).std();
     const double ratio = (s / kGnssInsSimSigma[i]) * (s / kGnssInsSimSigma[i]);
