@@ -96,7 +96,7 @@ TEST(GnssInsSimMotion, BadFilesNameFileLineAndColumn) {
   EXPECT_EQ(from_text(head + "1,0,nan,0,0,0,0,5,1\n"),
             "m.csv:4: column 3 (pitch (deg)): \"nan\" is not allowed; allowed: a finite number");
   EXPECT_EQ(from_text(head + "1,0,0,0,0,0,0,-5,1\n"),
-            "m.csv:4: column 8 (command duration (s)): \"-5\" is not allowed; allowed: 0 < "
+            "m.csv:4: column 8 (command duration (s)): \"-5\" is not allowed; allowed: 0 <= "
             "duration <= 100000 s");
   EXPECT_EQ(from_text(head + "2.5,0,0,0,0,0,0,5,1\n"),
             "m.csv:4: column 1 (command type): \"2.5\" is not allowed; allowed: 1, 2, 3, 4 or 5");
@@ -105,6 +105,31 @@ TEST(GnssInsSimMotion, BadFilesNameFileLineAndColumn) {
             std::string::npos);
   EXPECT_NE(ErrorOf([] { ReadGnssInsSimMotion(kData / "no_such_file.csv"); }).find("cannot open"),
             std::string::npos);
+}
+
+TEST(GnssInsSimMotion, BlankCommandCellsAreZeroAsInGnssInsSim) {
+  // gnss-ins-sim's own motion_def-static.csv before commit e7f1c68: `1,0,0,0,0,,,500,0`.
+  const MotionSpec m =
+      ReadGnssInsSimMotion(kData / "gnss_ins_sim" / "motion_def-static-54b4415.csv");
+  ASSERT_EQ(m.segments.size(), 1u);
+  const auto& c = std::get<GnssInsSimCommand>(m.segments[0]);
+  EXPECT_EQ(c.type, 1);
+  EXPECT_EQ(c.v_b, Vector3d::Zero());
+  EXPECT_EQ(c.duration_s, 500.0);
+  EXPECT_FALSE(c.gps_visible);
+  std::istringstream blanks("h\n32,120,0,0,0,0,0,0,0\nh\n1,,,,,,,5,\n2,,,,,,,,\n");
+  const MotionSpec b = ReadGnssInsSimMotion(blanks, "m.csv");
+  ASSERT_EQ(b.segments.size(), 2u);
+  EXPECT_EQ(std::get<GnssInsSimCommand>(b.segments[0]).duration_s, 5.0);
+  EXPECT_EQ(std::get<GnssInsSimCommand>(b.segments[1]).duration_s, 0.0);  // no step, as there
+  // Not blank and not a number stays an error; so does a blank initial state (gnss-ins-sim would
+  // start from NaN).
+  std::istringstream text("h\n32,120,0,0,0,0,0,0,0\nh\n1,0,0,0,x,0,0,5,1\n");
+  EXPECT_EQ(ErrorOf([&] { ReadGnssInsSimMotion(text, "m.csv"); }),
+            "m.csv:4: column 5 (vx_body (m/s)): \"x\" is not allowed; allowed: a finite number");
+  std::istringstream initial("h\n32,120,,0,0,0,0,0,0\nh\n1,0,0,0,0,0,0,5,1\n");
+  EXPECT_EQ(ErrorOf([&] { ReadGnssInsSimMotion(initial, "m.csv"); }),
+            "m.csv:2: column 3 (ini alt (m)): \"\" is not allowed; allowed: a finite number");
 }
 
 TEST(TruthProfile, ReadsGrovesLayoutWithOptionalHeader) {

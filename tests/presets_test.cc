@@ -57,7 +57,8 @@ TEST(ImuCatalogue, EveryDescriptionCitesASourceAndStatesItsAssumptions) {
     const std::string& d = model.description;
     const bool cites =
         d.find("seed 00") != std::string::npos || d.find("datasheet") != std::string::npos ||
-        d.find("brochure") != std::string::npos || d.find("leaflet") != std::string::npos;
+        d.find("brochure") != std::string::npos || d.find("leaflet") != std::string::npos ||
+        d.find("source code") != std::string::npos;  // another simulator's built-in models
     EXPECT_TRUE(cites) << model.name << ": " << d;
     // Every preset leaves something to assumption (no source gives every model term).
     EXPECT_NE(d.find("ssumed"), std::string::npos) << model.name;
@@ -390,6 +391,38 @@ TEST(DatasheetPresets, Bmi088ListsItsAssumptions) {
   const std::string& d = FindImuPreset("bmi088").description;
   EXPECT_NE(d.find("BST-BMI088-DS001"), std::string::npos);
   EXPECT_NE(d.find("Assumed"), std::string::npos);
+}
+
+// gnss-ins-sim's gnss_ins_sim/sim/imu_model.py (commit 966ff27) computes its parameters as
+// b_drift [deg/h] * D2R / 3600, arw [deg/sqrt(h)] * D2R / 60, vrw [m/s/sqrt(h)] / 60 with
+// D2R = pi / 180, b_corr = 100 s, b = 0; the presets must hold the same doubles (to 1 ulp: the
+// operations are grouped differently) and start the Gauss-Markov bias at 0 as it does.
+TEST(GnssInsSimPresets, HoldItsLowMidHighAccuracyParametersAndStartTheBiasAtZero) {
+  struct Level {
+    const char* name;
+    double gyro_drift_deg_per_h, arw_deg_per_sqrt_h, accel_drift_m_per_s2, vrw_m_per_s_per_sqrt_h;
+  };
+  const double d2r = kPi / 180.0;
+  for (const Level& l : {Level{"gnss-ins-sim-low", 10.0, 0.75, 2.0e-4, 0.05},
+                         Level{"gnss-ins-sim-mid", 3.5, 0.25, 5.0e-5, 0.03},
+                         Level{"gnss-ins-sim-high", 0.1, 2.0e-3, 3.6e-6, 2.5e-5}}) {
+    SCOPED_TRACE(l.name);
+    const ImuErrorModel& m = FindImuPreset(l.name);
+    EXPECT_DOUBLE_EQ(m.gyro.bias_gauss_markov.sigma, l.gyro_drift_deg_per_h * d2r / 3600.0);
+    EXPECT_DOUBLE_EQ(m.gyro.white_noise_density, l.arw_deg_per_sqrt_h * d2r / 60.0);
+    EXPECT_DOUBLE_EQ(m.accel.bias_gauss_markov.sigma, l.accel_drift_m_per_s2);
+    EXPECT_DOUBLE_EQ(m.accel.white_noise_density, l.vrw_m_per_s_per_sqrt_h / 60.0);
+    for (const TriadErrorParams* t : {&m.gyro, &m.accel}) {
+      EXPECT_EQ(t->bias_gauss_markov.tau_s, 100.0);
+      EXPECT_TRUE(t->bias_gauss_markov.start_at_zero);
+      EXPECT_EQ(t->fixed_bias, Eigen::Vector3d::Zero());
+      EXPECT_EQ(t->turn_on_bias_sigma, 0.0);
+      EXPECT_EQ(t->bias_flicker.bias_instability, 0.0);
+      EXPECT_EQ(t->scale_factor_sigma, 0.0);
+      EXPECT_EQ(t->misalignment_sigma_rad, 0.0);
+    }
+    EXPECT_NE(m.description.find("imu_model.py"), std::string::npos);
+  }
 }
 
 }  // namespace

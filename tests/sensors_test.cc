@@ -386,6 +386,53 @@ TEST(SensorNoiseTest, GaussMarkovAutocorrelationAtLagTauIsSigmaSquaredOverE) {
   EXPECT_LT(ratio, hi);
 }
 
+TEST(SensorNoiseTest, GaussMarkovStartedAtZeroGrowsAsOneMinusExpMinusTwoTOverTau) {
+  // start_at_zero (gnss-ins-sim's convention): b(0) = 0 exactly, and b(t) ~ N(0, sigma^2 (1 -
+  // e^{-2 t / tau})) (the exact AR(1) recursion from 0). At t = tau / 2: sigma^2 (1 - 1/e);
+  // chi-square bounds on 3R squares. The other terms' deviates are unchanged (own streams): the
+  // white noise of the same run is bit-identical with and without the option.
+  const double sigma = 3e-5, tau_s = 0.5, rate_hz = 100.0;
+  ImuErrorModel model;
+  model.gyro.bias_gauss_markov = {sigma, tau_s, true};
+  const int lag = static_cast<int>(0.5 * tau_s * rate_hz);
+  const int runs = 5'000;
+  long double sum_squares = 0;
+  for (int r = 0; r < runs; ++r) {
+    ImuErrorSimulator sim(model, 2718, r, rate_hz);
+    ImuSample zero, first, measured;
+    sim.Apply(zero, &first);
+    EXPECT_EQ(first.omega_ib_b, Vector3d::Zero());
+    for (int k = 1; k <= lag; ++k) sim.Apply(zero, &measured);
+    sum_squares += static_cast<long double>(measured.omega_ib_b.squaredNorm());
+  }
+  const double n = 3.0 * runs;
+  const auto [lo, hi] = VarianceRatioBounds(n);
+  const double ratio =
+      static_cast<double>(sum_squares / n) / (sigma * sigma * (1.0 - std::exp(-1.0)));
+  EXPECT_GT(ratio, lo);
+  EXPECT_LT(ratio, hi);
+
+  // Same run with a stationary start: the outputs differ by exactly a^k b(0) (a = e^{-dt/tau}),
+  // i.e. the white-noise and Gauss-Markov drive deviates are the same. Tolerance: rounding of the
+  // recursions, 1e-12 relative to sigma.
+  ImuErrorModel zero_start = model;
+  zero_start.gyro.white_noise_density = 1e-4;
+  ImuErrorModel steady_start = zero_start;
+  steady_start.gyro.bias_gauss_markov.start_at_zero = false;
+  ImuErrorSimulator a(zero_start, 5, 1, rate_hz), b(steady_start, 5, 1, rate_hz);
+  ImuSample zero, ya, yb;
+  a.Apply(zero, &ya);
+  b.Apply(zero, &yb);
+  const Vector3d b0 = yb.omega_ib_b - ya.omega_ib_b;
+  EXPECT_GT(b0.norm(), 0.0);
+  const double decay = std::exp(-1.0 / (rate_hz * tau_s));
+  for (int k = 1; k <= lag; ++k) {
+    a.Apply(zero, &ya);
+    b.Apply(zero, &yb);
+    EXPECT_LT((yb.omega_ib_b - ya.omega_ib_b - std::pow(decay, k) * b0).norm(), 1e-12 * sigma);
+  }
+}
+
 TEST(SensorNoiseTest, GaussMarkovIncrementHasExactIntegralVarianceEvenForDtNearTau) {
   // Stationary OU integrated over h: Var = 2 sigma^2 T^2 (x - 1 + e^-x), x = h / T
   // (Gardiner 3.8.4). At x = 1 this is 0.736 sigma^2 h^2, far from the sigma^2 h^2 of a

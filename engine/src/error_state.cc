@@ -16,7 +16,8 @@ BiasStateModel BiasModelOf(const TriadErrorParams& p, const std::string& path,
   const bool gm = p.bias_gauss_markov.sigma > 0.0;
   const bool rw = p.random_walk > 0.0;
   if (gm) {
-    b.initial_sigma = p.bias_gauss_markov.sigma;
+    // A bias started at 0 (gnss-ins-sim's convention) has no initial uncertainty.
+    b.initial_sigma = p.bias_gauss_markov.start_at_zero ? 0.0 : p.bias_gauss_markov.sigma;
     b.tau_s = p.bias_gauss_markov.tau_s;
     b.driving_psd = 2.0 * p.bias_gauss_markov.sigma * p.bias_gauss_markov.sigma / b.tau_s;
     if (turn_on) unrepresented->push_back(path + ".turn_on_bias_sigma");

@@ -159,17 +159,22 @@ MotionSpec ReadGnssInsSimMotion(std::istream& in, const std::string& name) {
     reader.ExpectColumns(line, 8, 9, "command");
     double c[9];
     c[8] = 1.0;
-    for (size_t i = 0; i < line.fields.size(); ++i)
-      c[i] = reader.Number(line, i, kCommandColumns[i]);
+    // A blank cell is 0, as in gnss-ins-sim: numpy.genfromtxt reads it as NaN and
+    // Sim.__parse_motion() (gnss_ins_sim/sim/ins_sim.py) replaces NaN by 0 "to be compatible with
+    // older version motion def files" (e.g. motion_def-static.csv before commit e7f1c68:
+    // `1,0,0,0,0,,,500,0`). Text that is not a number stays an error.
+    for (size_t i = 0; i < line.fields.size(); ++i) {
+      c[i] = line.fields[i].empty() ? 0.0 : reader.Number(line, i, kCommandColumns[i]);
+    }
     GnssInsSimCommand command;
     if (c[0] != std::round(c[0]) || c[0] < 1.0 || c[0] > 5.0) {
       reader.Fail(line.number, "column 1 (command type): \"" + std::string(line.fields[0]) +
                                    "\" is not allowed; allowed: 1, 2, 3, 4 or 5");
     }
     command.type = static_cast<int>(c[0]);
-    if (!(c[7] > 0.0 && c[7] <= kMaxDuration_s)) {
+    if (!(c[7] >= 0.0 && c[7] <= kMaxDuration_s)) {
       reader.Fail(line.number, "column 8 (command duration (s)): \"" + std::string(line.fields[7]) +
-                                   "\" is not allowed; allowed: 0 < duration <= 100000 s");
+                                   "\" is not allowed; allowed: 0 <= duration <= 100000 s");
     }
     if (c[8] != 0.0 && c[8] != 1.0) {
       reader.Fail(line.number, "column 9 (GPS visibility): \"" + std::string(line.fields[8]) +

@@ -3,6 +3,7 @@
 // reason. Datasheet units are converted to SI by the constexpr helpers at the top of this file.
 #include "driftlab/presets.h"
 
+#include <charconv>
 #include <numbers>
 #include <string>
 
@@ -44,6 +45,13 @@ constexpr double Percent(double percent) { return percent * 1e-2; }
 // Gyro g-sensitivity: 1 (deg/s)/g = (pi / 180) / kG (rad/s)/(m/s^2); likewise for (deg/h)/g.
 constexpr double DegPerSPerG(double v) { return DegPerS(v) / kG; }
 constexpr double DegPerHPerG(double v) { return DegPerH(v) / kG; }
+
+// Shortest decimal text of a datasheet figure, for descriptions ("3.5", "0.0002").
+std::string Num(double x) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), x);
+  return std::string(buffer, result.ptr);
+}
 
 // One triad's parameters in the order the descriptions list them; converted to TriadErrorParams.
 struct Triad {
@@ -561,6 +569,51 @@ ImuErrorModel Bmi088() {
             .range = Gee(24.0)});
 }
 
+// ---- gnss-ins-sim's built-in accuracy levels
+// ------------------------------------------------------ Source code: gnss_ins_sim/sim/imu_model.py
+// of github.com/Aceinna/gnss-ins-sim, commit 966ff271bf21d08fbd0e31d1eb47fa5f3acef8d3, dictionaries
+// gyro_/accel_{low,mid,high}_accuracy, in that tool's own parametrisation: 'b' constant bias (0 in
+// all three), 'b_drift' the 1-sigma of a first-order Gauss-Markov bias with correlation time
+// 'b_corr' (100 s in all three), 'arw' / 'vrw' white noise. pathgen.bias_drift() starts that bias
+// at 0 in every run, hence start_at_zero. Its discretisation b_{k+1} = (1 - dt / tau) b_k + sigma
+// sqrt(1 - exp(-2 dt / tau)) w_k differs from driftlab's exact a = exp(-dt / tau) by (dt / tau)^2 /
+// 2 in a (5e-9 at 100 Hz): the bias variance at time t differs by less than 1e-4 relative. Its
+// white noise, arw / sqrt(dt) per point sample, is driftlab's point-sample white noise of density
+// arw.
+
+ImuErrorModel GnssInsSimAccuracy(const char* level, double gyro_drift_deg_per_h,
+                                 double arw_deg_per_sqrt_h, double accel_drift_m_per_s2,
+                                 double vrw_m_per_s_per_sqrt_h) {
+  const std::string name = std::string("gnss-ins-sim-") + level;
+  const std::string description =
+      std::string("gnss-ins-sim's built-in '") + level +
+      "-accuracy' IMU (source code: gnss_ins_sim/sim/imu_model.py, github.com/Aceinna/"
+      "gnss-ins-sim commit 966ff27, gyro_/accel_" +
+      level + "_accuracy). Gyro: Gauss-Markov bias sigma " + Num(gyro_drift_deg_per_h) +
+      " deg/h, tau 100 s, starting at 0 in each run as gnss-ins-sim does (pathgen.bias_drift); "
+      "ARW " +
+      Num(arw_deg_per_sqrt_h) +
+      " deg/sqrt(h); constant bias 0. Accel: Gauss-Markov "
+      "bias sigma " +
+      Num(accel_drift_m_per_s2) + " m/s^2, tau 100 s, starting at 0; VRW " +
+      Num(vrw_m_per_s_per_sqrt_h) +
+      " m/s/sqrt(h); constant bias 0. Assumed: nothing else "
+      "(gnss-ins-sim models no turn-on bias, scale factor, misalignment, random walk, "
+      "quantization or range; all off here).";
+  ImuErrorModel m;
+  m.name = name;
+  m.description = description;
+  m.gyro.bias_gauss_markov = {DegPerH(gyro_drift_deg_per_h), 100.0, true};
+  m.gyro.white_noise_density = DegPerSqrtH(arw_deg_per_sqrt_h);
+  m.accel.bias_gauss_markov = {accel_drift_m_per_s2, 100.0, true};
+  m.accel.white_noise_density = MPerSPerSqrtH(vrw_m_per_s_per_sqrt_h);
+  return m;
+}
+
+ImuErrorModel GnssInsSimLow() { return GnssInsSimAccuracy("low", 10.0, 0.75, 2.0e-4, 0.05); }
+ImuErrorModel GnssInsSimMid() { return GnssInsSimAccuracy("mid", 3.5, 0.25, 5.0e-5, 0.03); }
+ImuErrorModel GnssInsSimHigh() { return GnssInsSimAccuracy("high", 0.1, 2.0e-3, 3.6e-6, 2.5e-5); }
+
 std::vector<ImuErrorModel> BuildCatalogue() {
   return {RateGrade(),
           IndustrialGrade(),
@@ -580,7 +633,10 @@ std::vector<ImuErrorModel> BuildCatalogue() {
           Stim300(),
           Hg1700(),
           Hg9900(),
-          Bmi088()};
+          Bmi088(),
+          GnssInsSimLow(),
+          GnssInsSimMid(),
+          GnssInsSimHigh()};
 }
 
 }  // namespace

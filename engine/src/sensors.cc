@@ -270,8 +270,12 @@ TriadErrorSimulator::TriadErrorSimulator(const TriadErrorParams& params, SensorI
     gm_d_ = std::sqrt(std::max(0.0, var_eps - gm_c_ * gm_c_));
     gm_ch_ = add_channels(ErrorTerm::kGaussMarkov, 1);
     gm_int_ch_ = add_channels(ErrorTerm::kGaussMarkovIntegral, 1);
+    // Stationary start N(0, sigma^2), or 0 (GaussMarkovParams::start_at_zero). The start draw has
+    // its own stream, so skipping it changes no other deviate of the run.
     for (int i = 0; i < 3; ++i) {
-      gm_state_[i] = sigma * stream(ErrorTerm::kInitialState, i, 0).Gaussian(0);
+      gm_state_[i] = params.bias_gauss_markov.start_at_zero
+                         ? 0.0
+                         : sigma * stream(ErrorTerm::kInitialState, i, 0).Gaussian(0);
     }
   }
 

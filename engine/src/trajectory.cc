@@ -269,8 +269,13 @@ struct PlanState {
 
 class Planner {
  public:
-  Planner(const MotionSpec& motion, const NavEnvironment& env, std::vector<Piece>* pieces)
-      : motion_(motion), pieces_(pieces) {
+  Planner(const MotionSpec& motion, const NavEnvironment& env, double rate_hz,
+          std::vector<Piece>* pieces, std::vector<std::pair<double, double>>* gps_invisible_s)
+      : motion_(motion),
+        pieces_(pieces),
+        gps_invisible_s_(gps_invisible_s),
+        rate_hz_(rate_hz),
+        dt_s_(1.0 / rate_hz) {
     g_m_per_s2_ = env.Gravity(motion.initial.llh.lat_rad, motion.initial.llh.h_m).norm();
     state_.euler = motion.initial.attitude;
     state_.v_eb_n = motion.initial.v_eb_n;
@@ -279,8 +284,10 @@ class Planner {
   void Plan() {
     for (size_t i = 0; i < motion_.segments.size(); ++i) {
       const std::string path = motion_.field_path + ".segments[" + std::to_string(i) + "]";
+      if (!std::holds_alternative<GnssInsSimCommand>(motion_.segments[i])) FinishExecutor(false);
       std::visit([&](const auto& segment) { PlanSegment(segment, path); }, motion_.segments[i]);
     }
+    FinishExecutor(true);
   }
 
   double duration() const { return state_.t; }
@@ -557,6 +564,7 @@ class Planner {
     const std::string base = path + ".zigzag";
     CheckPositive(base + ".amplitude_m", s.amplitude_m, 1.0e6, " m");
     CheckPositive(base + ".period_s", s.period_s, kMaxDuration_s, " s");
+    CheckSampledPeriod(base + ".period_s", s.period_s);
     CheckDuration(base + ".duration_s", s.duration_s);
     if (motion_.vehicle.coordinated_turns) {
       RejectText(base,
@@ -582,6 +590,19 @@ class Planner {
     TrackPiece p = TrackTemplate(V, chi, vD, 0.0);
     p.zigzag = Wave{A, 2.0 * M_PI / s.period_s, 0.0};
     Add(s.duration_s, p);
+  }
+
+  // A periodic motion sampled at rate_hz: the Nyquist limit is 2 samples per period; a period of
+  // fewer than kMinSamplesPerPeriod samples would alias in the output (issue 15).
+  static constexpr double kMinSamplesPerPeriod = 4.0;
+  void CheckSampledPeriod(const std::string& field, double period_s) const {
+    const double min_period_s = kMinSamplesPerPeriod * dt_s_;
+    if (period_s < min_period_s) {
+      Reject(field, period_s,
+             field.substr(field.rfind('.') + 1) + " >= " + Num(min_period_s) + " s (" +
+                 Num(kMinSamplesPerPeriod) + " output intervals at rate_hz " + Num(rate_hz_) +
+                 " Hz; the Nyquist limit is 2)");
+    }
   }
 
   void PlanSegment(const ShipMotionSegment& s, const std::string& path) {
@@ -611,6 +632,7 @@ class Planner {
                    " <= " + Num(c.max_amplitude * c.scale) + c.unit);
       }
       CheckPositive(name + "_period_s", c.period, kMaxDuration_s, " s");
+      if (c.amplitude > 0.0) CheckSampledPeriod(name + "_period_s", c.period);
       if (!std::isfinite(c.phase)) Reject(name + "_phase_deg", c.phase * kRadToDeg, "finite");
       longest_any = std::max(longest_any, c.period);
       if (c.amplitude > 0.0) longest = std::max(longest, c.period);
@@ -713,46 +735,116 @@ class Planner {
   }
 
   // ---- gnss-ins-sim commands ----
+  //
+  // The motion-command executor of gnss-ins-sim (gnss_ins_sim/pathgen/pathgen.py, path_gen(),
+  // github.com/Aceinna/gnss-ins-sim at 966ff27), re-implemented from its description. It is a
+  // discrete-time loop at the simulation rate (gnss-ins-sim's IMU rate, here the job's rate_hz)
+  // over the state att = (yaw, pitch, roll) [rad, unwrapped], v_b [m/s], att_dot, v_dot_b; both
+  // rates carry over from one command to the next. Per step, with dt = 1 / rate_hz:
+  //   type 1:   att_dot = a att_dot + (1 - a) command rates;  v_dot_b = a v_dot_b + (1 - a) command
+  //             acceleration  (first-order low-pass, a = 0.9);
+  //   types 2-5 (targets att_com, v_com_b fixed at the command's start, parse_motion_def()):
+  //             v_filt  = a v_filt + (1 - a) v_com_b   (v_filt starts at v_b)
+  //             v_dot_b = clip((v_filt - v_b) / dt, +-max_acc)
+  //             att_dd  = clip(kp (att_com - att) - kd att_dot, +-max_dw)     (PD, kp 5, kd 10)
+  //             att_dot = clip(att_dot + att_dd dt, +-max_w)
+  //             converged if |att - att_com| < 1e-4 and |v_b - v_com_b| < 1e-4 (2-norms);
+  //   then the step: att += att_dot dt, v_b += v_dot_b dt (the rates are constant over the step).
+  // A command runs at most round(duration * rate_hz) steps (round half to even, as numpy's round);
+  // the step in which it converges is still taken, after which both rates are set to zero and the
+  // next command starts. gnss-ins-sim records the state before each step, so its output ends one
+  // step before the executor's last step: the import drops that last step, and gives the same
+  // number of samples.
+  //
+  // Each step is a BodyPiece (Euler angles linear, v_b linear in time). Consecutive steps whose
+  // rates agree within kExecutorMergeTolerance are one piece between the executor's states at its
+  // ends (so the ends are exact and the rates inside differ by at most the tolerance).
+  static constexpr double kExecutorFilterAlpha = 0.9;
+  static constexpr double kExecutorKp = 5.0;
+  static constexpr double kExecutorKd = 10.0;
+  static constexpr double kExecutorConvergence = 1e-4;      // rad and m/s
+  static constexpr double kExecutorMergeTolerance = 1e-12;  // rad/s and m/s^2
+  // Type-1 command limits: the Euler-angle rates as the mobility limit's upper bound (100 rad/s),
+  // accelerations as max_acceleration's (1000 m/s^2); beyond them the angles and the Gauss-Legendre
+  // sums lose all precision and, for huge values, overflow to inf and NaN.
+  static constexpr double kMaxCommandRate_rad_per_s = 100.0;
+  static constexpr double kMaxCommandAcceleration_m_per_s2 = 1000.0;
 
-  // Rest-to-rest motion of one Euler angle by `delta` with |acceleration| alpha and |rate| <= w.
-  struct AngleProfile {
-    double start = 0.0, delta = 0.0, alpha = 0.0, t1 = 0.0, t2 = 0.0, t3 = 0.0;
-    AngleProfile(double start_rad, double delta_rad, double alpha_max, double w_max)
-        : start(start_rad), delta(delta_rad) {
-      const double d = std::abs(delta);
-      alpha = alpha_max;
-      if (d == 0.0) return;
-      if (d >= w_max * w_max / alpha_max) {  // trapezoidal rate: reaches w_max
-        t1 = w_max / alpha_max;
-        t2 = t1 + (d - w_max * t1) / w_max;
-      } else {  // triangular rate
-        t1 = std::sqrt(d / alpha_max);
-        t2 = t1;
-      }
-      t3 = t2 + t1;
-    }
-    void Eval(double t, double* value, double* rate, double* accel) const {
-      const double sg = delta < 0.0 ? -1.0 : 1.0;
-      if (delta == 0.0 || t >= t3) {
-        *value = start + delta;
-        *rate = *accel = 0.0;
-      } else if (t < t1) {
-        *value = start + sg * 0.5 * alpha * t * t;
-        *rate = sg * alpha * t;
-        *accel = sg * alpha;
-      } else if (t < t2) {
-        const double w = alpha * t1;
-        *value = start + sg * (0.5 * alpha * t1 * t1 + w * (t - t1));
-        *rate = sg * w;
-        *accel = 0.0;
-      } else {
-        const double tau = t3 - t;
-        *value = start + delta - sg * 0.5 * alpha * tau * tau;
-        *rate = sg * alpha * tau;
-        *accel = -sg * alpha;
-      }
-    }
+  struct Executor {
+    bool active = false;  // the previous segment was a gnss-ins-sim command
+    double t_start = 0.0;
+    int64_t steps = 0;  // steps taken since t_start
+    Vector3d att = Vector3d::Zero(), v_b = Vector3d::Zero();
+    Vector3d att_dot = Vector3d::Zero(), v_dot_b = Vector3d::Zero();
+    // Open run of merged steps.
+    int64_t run_steps = 0;
+    Vector3d run_att = Vector3d::Zero(), run_v_b = Vector3d::Zero();
+    Vector3d run_att_dot = Vector3d::Zero(), run_v_dot_b = Vector3d::Zero();
+    Vector3d att_before_last = Vector3d::Zero(), v_b_before_last = Vector3d::Zero();
   };
+
+  static Vector3d Clip(const Vector3d& x, double limit) {
+    Vector3d y = x;
+    for (int i = 0; i < 3; ++i) {
+      if (y(i) > limit) y(i) = limit;
+      if (y(i) < -limit) y(i) = -limit;
+    }
+    return y;
+  }
+
+  void CloseRun() {
+    Executor& x = exec_;
+    if (x.run_steps == 0) return;
+    const int64_t first = x.steps - x.run_steps;
+    const double t0 = x.t_start + static_cast<double>(first) * dt_s_;
+    const double t1 = x.t_start + static_cast<double>(x.steps) * dt_s_;
+    const double T = t1 - t0;
+    BodyPiece p;
+    const Vector3d att_end = x.att;
+    p.e0 = Vector3d(x.run_att(2), x.run_att(1), x.run_att(0));
+    p.e1 =
+        Vector3d(att_end(2) - x.run_att(2), att_end(1) - x.run_att(1), att_end(0) - x.run_att(0)) /
+        T;
+    p.b_start = x.run_v_b;
+    p.b_end = x.v_b;
+    p.b_slope = (x.v_b - x.run_v_b) / T;
+    p.duration = T;
+    Piece piece;
+    piece.t0 = t0;
+    piece.t1 = t1;
+    piece.max_substep_s = p.Uniform() ? kUniformSubstep_s : kDynamicSubstep_s;
+    piece.kin = p;
+    pieces_->push_back(piece);
+    x.run_steps = 0;
+    state_.t = t1;
+    state_.euler = EulerAngles{att_end(2), att_end(1), att_end(0)};
+    state_.v_b = x.v_b;
+    state_.has_body = true;
+    state_.has_track = false;
+    state_.v_eb_n = EulerToDcm(state_.euler) * x.v_b;
+  }
+
+  void ExecutorStep() {
+    Executor& x = exec_;
+    auto close = [](const Vector3d& a, const Vector3d& b) {
+      return (a - b).cwiseAbs().maxCoeff() <= kExecutorMergeTolerance;
+    };
+    if (x.run_steps > 0 && !(close(x.att_dot, x.run_att_dot) && close(x.v_dot_b, x.run_v_dot_b))) {
+      CloseRun();
+    }
+    if (x.run_steps == 0) {
+      x.run_att = x.att;
+      x.run_v_b = x.v_b;
+      x.run_att_dot = x.att_dot;
+      x.run_v_dot_b = x.v_dot_b;
+    }
+    x.att_before_last = x.att;
+    x.v_b_before_last = x.v_b;
+    x.v_b = x.v_b + x.v_dot_b * dt_s_;
+    x.att = x.att + x.att_dot * dt_s_;
+    ++x.steps;
+    ++x.run_steps;
+  }
 
   void PlanSegment(const GnssInsSimCommand& cmd, const std::string& path) {
     // Field of one column: "<segments path>.gnss_ins_sim.<column>" or "<file>:<line> (<column>)".
@@ -769,108 +861,109 @@ class Planner {
       CheckFinite(field(angle_names[i]), cmd.euler_ypr(i));
       CheckFinite(field(velocity_names[i]), cmd.v_b(i));
     }
-    const std::string duration_field = field("duration_s");
-    if (!(cmd.duration_s > 0.0 && cmd.duration_s <= kMaxDuration_s)) {
-      Reject(duration_field, cmd.duration_s, "0 < duration_s <= " + Num(kMaxDuration_s) + " s");
-    }
-
-    const Vector3d e_start(state_.euler.roll_rad, state_.euler.pitch_rad, state_.euler.yaw_rad);
-    const Vector3d v_b_start = state_.has_body
-                                   ? state_.v_b
-                                   : Vector3d(EulerToDcm(state_.euler).transpose() * state_.v_eb_n);
-    const Vector3d cmd_rpy(cmd.euler_ypr(2), cmd.euler_ypr(1), cmd.euler_ypr(0));
-
     if (cmd.type == 1) {
-      const double T = cmd.duration_s;
-      BodyPiece p;
-      p.e0 = e_start;
-      p.e1 = cmd_rpy;
-      p.b_start = v_b_start;
-      p.b_slope = cmd.v_b;
-      p.b_end = v_b_start + cmd.v_b * T;
-      p.duration = T;
-      AddBody(T, p, p.e0 + p.e1 * T, p.b_end);
-      return;
+      for (int i = 0; i < 3; ++i) {
+        if (!(std::abs(cmd.euler_ypr(i)) <= kMaxCommandRate_rad_per_s)) {
+          Reject(field(angle_names[i]), cmd.euler_ypr(i) * kRadToDeg,
+                 std::string("|") + angle_names[i] +
+                     " rate| <= " + Num(kMaxCommandRate_rad_per_s * kRadToDeg) +
+                     " deg/s (100 rad/s) in a type-1 command");
+        }
+        if (!(std::abs(cmd.v_b(i)) <= kMaxCommandAcceleration_m_per_s2)) {
+          Reject(field(velocity_names[i]), cmd.v_b(i),
+                 std::string("|") + velocity_names[i] + " acceleration| <= " +
+                     Num(kMaxCommandAcceleration_m_per_s2) + " m/s^2 in a type-1 command");
+        }
+      }
     }
-    // Targets (pathgen.py parse_motion_def): 2 abs/abs, 3 rel/rel, 4 abs att/rel vel,
-    // 5 rel att/abs vel.
+    const std::string duration_field = field("duration_s");
+    // 0 is allowed: gnss-ins-sim then takes no step (round(duration * rate) = 0).
+    if (!(cmd.duration_s >= 0.0 && cmd.duration_s <= kMaxDuration_s)) {
+      Reject(duration_field, cmd.duration_s, "0 <= duration_s <= " + Num(kMaxDuration_s) + " s");
+    }
+
+    Executor& x = exec_;
+    if (!x.active) {  // start of a block of commands: from the planned state, at rest rates
+      x = Executor{};
+      x.active = true;
+      x.t_start = state_.t;
+      x.att = Vector3d(state_.euler.yaw_rad, state_.euler.pitch_rad, state_.euler.roll_rad);
+      x.v_b = state_.has_body ? state_.v_b
+                              : Vector3d(EulerToDcm(state_.euler).transpose() * state_.v_eb_n);
+    }
+    const GnssInsSimLimits& lim = motion_.gnss_ins_sim_limits;
+    const double a = kExecutorFilterAlpha, b = 1.0 - kExecutorFilterAlpha;
+    // round(duration * fs) with numpy's round half to even (the default rounding mode).
+    const auto max_steps = static_cast<int64_t>(std::nearbyint(cmd.duration_s * rate_hz_));
+    // Targets (parse_motion_def): 2 abs/abs, 3 rel/rel, 4 abs att/rel vel, 5 rel att/abs vel.
     const bool absolute_attitude = cmd.type == 2 || cmd.type == 4;
     const bool absolute_velocity = cmd.type == 2 || cmd.type == 5;
-    const Vector3d e_target = absolute_attitude ? cmd_rpy : Vector3d(e_start + cmd_rpy);
-    const Vector3d v_target = absolute_velocity ? cmd.v_b : Vector3d(v_b_start + cmd.v_b);
-    const GnssInsSimLimits& lim = motion_.gnss_ins_sim_limits;
-    std::vector<AngleProfile> angles;
-    std::vector<double> times = {0.0};
-    double T = 0.0;
-    for (int i = 0; i < 3; ++i) {
-      angles.emplace_back(e_start(i), e_target(i) - e_start(i),
-                          lim.max_angular_acceleration_rad_per_s2, lim.max_angular_rate_rad_per_s);
-      const AngleProfile& a = angles.back();
-      times.insert(times.end(), {a.t1, a.t2, a.t3});
-      T = std::max(T, a.t3);
-    }
-    double v_end_time[3];
-    for (int i = 0; i < 3; ++i) {
-      v_end_time[i] = std::abs(v_target(i) - v_b_start(i)) / lim.max_acceleration_m_per_s2;
-      times.push_back(v_end_time[i]);
-      T = std::max(T, v_end_time[i]);
-    }
-    if (T == 0.0) return;  // already at the target: the next command starts at once
-    T = std::min(T, cmd.duration_s);
-    times.push_back(T);
-    std::sort(times.begin(), times.end());
-    auto velocity_at = [&](int i, double t) {
-      if (t >= v_end_time[i]) return v_target(i);
-      const double sg = v_target(i) < v_b_start(i) ? -1.0 : 1.0;
-      return v_b_start(i) + sg * lim.max_acceleration_m_per_s2 * t;
-    };
-    auto velocity_slope = [&](int i, double t) {
-      if (t >= v_end_time[i]) return 0.0;
-      return (v_target(i) < v_b_start(i) ? -1.0 : 1.0) * lim.max_acceleration_m_per_s2;
-    };
-    for (size_t j = 0; j + 1 < times.size(); ++j) {
-      const double ta = times[j], tb = std::min(times[j + 1], T);
-      if (!(tb > ta)) continue;
-      const double tm = 0.5 * (ta + tb);
-      BodyPiece p;
-      Vector3d e_end;
-      for (int i = 0; i < 3; ++i) {
-        double value, rate, accel, dummy;
-        angles[static_cast<size_t>(i)].Eval(ta, &value, &rate, &dummy);
-        angles[static_cast<size_t>(i)].Eval(tm, &dummy, &dummy, &accel);
-        p.e0(i) = value;
-        p.e1(i) = rate;
-        p.e2(i) = 0.5 * accel;
-        angles[static_cast<size_t>(i)].Eval(tb, &e_end(i), &dummy, &dummy);
-        p.b_start(i) = velocity_at(i, ta);
-        p.b_end(i) = velocity_at(i, tb);
-        p.b_slope(i) = velocity_slope(i, tm);
+    const Vector3d att_com = absolute_attitude ? cmd.euler_ypr : Vector3d(x.att + cmd.euler_ypr);
+    const Vector3d v_com_b = absolute_velocity ? cmd.v_b : Vector3d(x.v_b + cmd.v_b);
+    Vector3d v_filt = x.v_b;
+    bool complete = false;
+    const int64_t first_step = x.steps;
+    for (int64_t n = 0; n < max_steps && !complete; ++n) {
+      if (cmd.type == 1) {
+        x.att_dot = a * x.att_dot + b * cmd.euler_ypr;
+        x.v_dot_b = a * x.v_dot_b + b * cmd.v_b;
+      } else {
+        v_filt = a * v_filt + b * v_com_b;
+        x.v_dot_b = Clip((v_filt - x.v_b) / dt_s_, lim.max_acceleration_m_per_s2);
+        const Vector3d att_dd = Clip(kExecutorKp * (att_com - x.att) + kExecutorKd * (-x.att_dot),
+                                     lim.max_angular_acceleration_rad_per_s2);
+        x.att_dot = Clip(x.att_dot + att_dd * dt_s_, lim.max_angular_rate_rad_per_s);
+        complete = (x.att - att_com).norm() < kExecutorConvergence &&
+                   (x.v_b - v_com_b).norm() < kExecutorConvergence;
       }
-      p.duration = tb - ta;
-      AddBody(tb - ta, p, e_end, p.b_end);
-      if (tb >= T) break;
+      ExecutorStep();
+    }
+    if (complete) {
+      x.att_dot.setZero();
+      x.v_dot_b.setZero();
+    }
+    if (!cmd.gps_visible && x.steps > first_step) {  // its GPS epochs are those of its steps
+      const double start_s = x.t_start + static_cast<double>(first_step) * dt_s_;
+      const double end_s = x.t_start + static_cast<double>(x.steps) * dt_s_;
+      if (!gps_invisible_s_->empty() && gps_invisible_s_->back().second >= start_s) {
+        gps_invisible_s_->back().second = end_s;
+      } else {
+        gps_invisible_s_->emplace_back(start_s, end_s);
+      }
+    }
+    if (!(x.v_b.norm() <= kMaxSpeed_m_per_s)) {
+      Reject(field(cmd.type == 1 ? "vx_body" : "duration_s"), x.v_b.norm(),
+             "a command ending at a speed <= " + Num(kMaxSpeed_m_per_s) +
+                 " m/s (the speed it reaches)");
     }
   }
 
-  void AddBody(double duration, const BodyPiece& p, const Vector3d& e_end,
-               const Vector3d& v_b_end) {
-    Piece piece;
-    piece.t0 = state_.t;
-    piece.t1 = state_.t + duration;
-    piece.max_substep_s = p.Uniform() ? kUniformSubstep_s : kDynamicSubstep_s;
-    piece.kin = p;
-    pieces_->push_back(piece);
-    state_.t = piece.t1;
-    state_.euler = EulerAngles{e_end.x(), e_end.y(), e_end.z()};
-    state_.v_b = v_b_end;
-    state_.has_body = true;
-    state_.has_track = false;
-    state_.v_eb_n = EulerToDcm(state_.euler) * v_b_end;
+  // Ends a block of consecutive gnss-ins-sim commands; `drop_last_step` when the motion ends with
+  // it (gnss-ins-sim's output stops at the state before the executor's last step).
+  void FinishExecutor(bool drop_last_step) {
+    Executor& x = exec_;
+    if (!x.active) return;
+    x.active = false;
+    if (drop_last_step && x.run_steps > 0) {
+      --x.steps;
+      if (--x.run_steps == 0) {
+        x.att = x.run_att;
+        x.v_b = x.run_v_b;
+      } else {
+        x.att = x.att_before_last;
+        x.v_b = x.v_b_before_last;
+      }
+    }
+    CloseRun();
   }
 
   const MotionSpec& motion_;
   std::vector<Piece>* pieces_;
+  std::vector<std::pair<double, double>>* gps_invisible_s_;
   PlanState state_;
+  Executor exec_;
+  double rate_hz_ = 1.0;
+  double dt_s_ = 1.0;
   double g_m_per_s2_ = 9.8;
 };
 
@@ -1109,6 +1202,7 @@ struct TrajectoryGenerator::Impl {
   int64_t step = 0;
   std::vector<Piece> pieces;
   std::vector<double> breakpoints;
+  std::vector<std::pair<double, double>> gps_invisible_s;
   NavState initial;
   ImuSample initial_sample;
   // Integration state at t = step / rate_hz: (L, lambda, h) as an unevaluated sum llh + llh_lo.
@@ -1248,7 +1342,7 @@ TrajectoryGenerator::TrajectoryGenerator(const MotionSpec& motion, double rate_h
     m.env = NavEnvironment::Wgs84();
   }
   if (motion.truth_profile.empty()) {
-    Planner planner(motion, m.env, &m.pieces);
+    Planner planner(motion, m.env, rate_hz, &m.pieces, &m.gps_invisible_s);
     planner.Plan();
     m.duration_s = planner.duration();
   } else {
@@ -1270,6 +1364,12 @@ TrajectoryGenerator::TrajectoryGenerator(const MotionSpec& motion, double rate_h
            "a total duration of at least one output interval, 1 / rate_hz = " + Num(m.dt_s) + " s");
   }
   for (size_t i = 1; i < m.pieces.size(); ++i) m.breakpoints.push_back(m.pieces[i].t0);
+  while (!m.gps_invisible_s.empty() && m.gps_invisible_s.back().first >= m.duration_s) {
+    m.gps_invisible_s.pop_back();  // only the dropped last step
+  }
+  if (!m.gps_invisible_s.empty()) {
+    m.gps_invisible_s.back().second = std::min(m.gps_invisible_s.back().second, m.duration_s);
+  }
 
   m.llh = Vector3d(start_llh.lat_rad, start_llh.lon_rad, start_llh.h_m);
   const Kinematics k0 = m.pieces.front().Evaluate(0.0);
@@ -1305,6 +1405,9 @@ int64_t TrajectoryGenerator::num_steps() const { return impl_->num_steps; }
 const NavState& TrajectoryGenerator::initial_state() const { return impl_->initial; }
 const ImuSample& TrajectoryGenerator::initial_sample() const { return impl_->initial_sample; }
 const std::vector<double>& TrajectoryGenerator::breakpoints_s() const { return impl_->breakpoints; }
+const std::vector<std::pair<double, double>>& TrajectoryGenerator::gps_invisible_s() const {
+  return impl_->gps_invisible_s;
+}
 int64_t TrajectoryGenerator::step() const { return impl_->step; }
 
 bool TrajectoryGenerator::IsStaticAt(double t_s) const {

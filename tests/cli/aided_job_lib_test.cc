@@ -15,6 +15,7 @@
 #include "driftlab/jobspec/result_file.h"
 #include "driftlab/monte_carlo.h"
 #include "driftlab/spec_error.h"
+#include "driftlab/trajectory.h"
 
 namespace driftlab::jobspec {
 namespace {
@@ -309,6 +310,36 @@ TEST(AidedJob, ComplementaryFilterReportsAttitudeErrorsOnly) {
   // through the levelling of the magnetometer: not checked here; see aiding_test.cc.)
   EXPECT_GT(last.components(6).rms(), 0.0);
   EXPECT_LT(last.components(6).rms(), 0.2);
+}
+
+// gnss-ins-sim's GPS-visibility column (issue 19): the 3d demo file alternates visible (1) and
+// invisible (0) commands; with GNSS aiding the invisible commands' times become outages, merged
+// with the job's own (here one overlapping the first invisible window).
+TEST(AidedJob, GnssInsSimGpsVisibilityZeroBecomesOutages) {
+  const std::string file =
+      std::string(DRIFTLAB_SOURCE_DIR) + "/tests/data/gnss_ins_sim/motion_def-3d.csv";
+  const std::string job = R"({"name": "gis", "rate_hz": 100,
+    "motion": {"earth_model": "FLAT", "gnss_ins_sim_file": {"path": ")" +
+                          file + R"("}},
+    "navigation": {"filter": "INS_GNSS_EKF"},
+    "aiding": {"gnss": {"outages": [{"start_s": 5, "end_s": 12}]}},
+    "sensor": {"preset": "tactical"},
+    "monte_carlo": {"runs": 2}})";
+  const MonteCarloSpec spec = ToMonteCarloSpec(JobFile{ParseJobJson(job), "."}, {});
+  const TrajectoryGenerator planned(spec.simulation.motion, 100.0);
+  const auto& invisible = planned.gps_invisible_s();
+  // Commands 1 (10 s, type 1) and 3, 5, 7 (types 2, converging early) have GPS 0.
+  ASSERT_EQ(invisible.size(), 4u);
+  EXPECT_EQ(invisible[0].first, 0.0);
+  EXPECT_NEAR(invisible[0].second, 10.0, 1e-12);  // k dt rounding
+  const std::vector<GnssOutage>& outages = spec.aiding.gnss->outages;
+  ASSERT_EQ(outages.size(), 4u);
+  EXPECT_EQ(outages[0].start_s, 0.0);  // [0, 10) and the job's [5, 12) merged
+  EXPECT_NEAR(outages[0].start_s + outages[0].duration_s, 12.0, 1e-12);
+  for (size_t i = 1; i < 4; ++i) {
+    EXPECT_EQ(outages[i].start_s, invisible[i].first);
+    EXPECT_EQ(outages[i].start_s + outages[i].duration_s, invisible[i].second);
+  }
 }
 
 }  // namespace

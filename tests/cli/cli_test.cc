@@ -143,6 +143,25 @@ INSTANTIATE_TEST_SUITE_P(
       return name;
     });
 
+// Issue 15: these ran and wrote NaN (huge type-1 rate) or aliased output (a roll period far below
+// the 0.01 s sample interval); both are refused at validation with status 2.
+TEST(Cli, HugeGnssInsSimRateAndAliasedShipPeriodAreRefusedWithStatus2) {
+  Scratch scratch;
+  const Result rate =
+      RunDriftlab({"validate", (kData / "bad_gnss_ins_sim_huge_rate.json").string()}, scratch);
+  EXPECT_EQ(rate.exit_status, 2);
+  EXPECT_NE(rate.err.find("bad_gnss_ins_sim_huge_rate.csv:5 (yaw): "), std::string::npos)
+      << rate.err;
+  EXPECT_NE(rate.err.find("|yaw rate| <= 5729.57"), std::string::npos) << rate.err;
+  const Result ship =
+      RunDriftlab({"validate", (kData / "bad_ship_roll_period.json").string()}, scratch);
+  EXPECT_EQ(ship.exit_status, 2);
+  EXPECT_NE(ship.err.find("motion.segments[0].ship_motion.roll_period_s: 0.001 is not allowed; "
+                          "allowed: roll_period_s >= 0.04 s"),
+            std::string::npos)
+      << ship.err;
+}
+
 TEST(Cli, JsonSyntaxErrorIsOneLineWithStatus2) {
   Scratch scratch;
   const fs::path out_dir = scratch.dir() / "out";

@@ -8,6 +8,8 @@
 #include <charconv>
 #include <cmath>
 #include <string>
+#include <utility>
+#include <variant>
 #include <vector>
 
 #include "driftlab/aiding.h"
@@ -246,11 +248,41 @@ void TranslateFilterAndAiding(const v1::Job& job, const MonteCarloOverrides& ove
   const v1::Aiding& aiding = job.aiding();
   if (aiding.has_gnss()) {
     double duration_s = 0.0;
-    if (aiding.gnss().outages_size() > 0) {
+    std::vector<std::pair<double, double>> invisible_s;
+    const bool gps_column =
+        std::any_of(spec->simulation.motion.segments.begin(),
+                    spec->simulation.motion.segments.end(), [](const Segment& s) {
+                      const auto* c = std::get_if<GnssInsSimCommand>(&s);
+                      return c != nullptr && !c->gps_visible;
+                    });
+    if (aiding.gnss().outages_size() > 0 || gps_column) {
       // Outages must lie inside the trajectory: its duration from the motion plan.
-      duration_s = TrajectoryGenerator(spec->simulation.motion, rate_hz).duration_s();
+      const TrajectoryGenerator planned(spec->simulation.motion, rate_hz);
+      duration_s = planned.duration_s();
+      invisible_s = planned.gps_invisible_s();
     }
     spec->aiding.gnss = ToGnssConfig(aiding.gnss(), rate_hz, duration_s);
+    // gnss-ins-sim's GPS-visibility column: no fix during the commands marked 0, in addition to
+    // the job's outages (union of both, ascending and non-overlapping as GnssConfig requires).
+    if (!invisible_s.empty()) {
+      std::vector<std::pair<double, double>> windows = invisible_s;
+      for (const GnssOutage& o : spec->aiding.gnss->outages) {
+        windows.emplace_back(o.start_s, o.start_s + o.duration_s);
+      }
+      std::sort(windows.begin(), windows.end());
+      std::vector<GnssOutage> merged;
+      double end_s = 0.0;
+      for (const auto& [start, end] : windows) {
+        if (!merged.empty() && start <= end_s) {
+          end_s = std::max(end_s, end);
+          merged.back().duration_s = end_s - merged.back().start_s;
+        } else {
+          merged.push_back(GnssOutage{start, end - start});
+          end_s = end;
+        }
+      }
+      spec->aiding.gnss->outages = merged;
+    }
   }
   if (aiding.has_barometer()) {
     spec->aiding.barometer = ToBarometerConfig(aiding.barometer(), rate_hz);

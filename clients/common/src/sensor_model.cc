@@ -181,6 +181,12 @@ void ApplyTriad(const Message& in, const TriadUnits& units, const std::string& p
     }
   }
 
+  // Field 18 (both triads): the Gauss-Markov start.
+  const FieldDescriptor* gm_start = descriptor->FindFieldByNumber(18);
+  if (reflection->HasField(in, gm_start)) {
+    out->bias_gauss_markov.start_at_zero = reflection->GetBool(in, gm_start);
+  }
+
   // Combinations the engine also checks, reported here with the job's field names.
   const auto& fields = *descriptor;
   auto name = [&fields](int number) { return fields.FindFieldByNumber(number)->name(); };

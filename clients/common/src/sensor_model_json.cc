@@ -63,6 +63,9 @@ std::vector<Field> Fields(const TriadErrorParams& p, const TriadUnits& u) {
 void FillTriad(const TriadErrorParams& p, const TriadUnits& u, Message* out) {
   const auto* descriptor = out->GetDescriptor();
   const auto* reflection = out->GetReflection();
+  if (p.bias_gauss_markov.start_at_zero) {  // field 18 in both triads
+    reflection->SetBool(out, descriptor->FindFieldByNumber(18), true);
+  }
   for (const Field& f : Fields(p, u)) {
     bool any = false;
     for (double v : f.si) any |= v != 0.0;

@@ -7,7 +7,9 @@
 //    line; then one command per line: type (1..5), yaw, pitch, roll (deg, or deg/s for type 1),
 //    vx, vy, vz body (m/s, or m/s^2 for type 1), duration (s), GPS visibility (0/1; optional,
 //    default 1; driftlab simulates no GNSS and only keeps it). Header lines are recognised as
-//    lines whose first field is not a number, so files without them are read too.
+//    lines whose first field is not a number, so files without them are read too. A blank cell
+//    of a command line is 0, as gnss-ins-sim reads it (NaN replaced by 0); the initial-state line
+//    must be complete (gnss-ins-sim would start from NaN).
 //  - Truth profile in the layout of Groves' motion-profile files (Groves, "Principles of GNSS,
 //    Inertial, and Multisensor Integrated Navigation Systems", 2nd ed., MATLAB software,
 //    Read_profile.m): one sample per line, time (s), latitude (deg), longitude (deg), height (m),

@@ -8,7 +8,9 @@
 //  * the IMUs of seed 000 (FOG IMU of the ship model) and seed 003 (ADXRS300 + ADXL330),
 //  * current IMUs from public datasheets (Analog Devices ADIS16470, ADIS16495-1, ADIS16467-1,
 //    TDK InvenSense ICM-42688-P, Movella/Xsens MTi-300, Safran STIM300, Honeywell HG1700 and
-//    HG9900, Bosch BMI088).
+//    HG9900, Bosch BMI088),
+//  * gnss-ins-sim's built-in accuracy levels ("gnss-ins-sim-low", "-mid", "-high") in that tool's
+//    own parametrisation (Gauss-Markov bias started at 0, white noise), from its source code.
 // Every preset's `description` names its source (seed or datasheet with revision) and lists every
 // parameter the source does not give as "assumed: ...", with the reasoning.
 //

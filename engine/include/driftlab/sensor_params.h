@@ -17,9 +17,14 @@ namespace driftlab {
 
 // First-order Gauss-Markov process b' = -b / tau + w, steady-state standard deviation sigma.
 // Autocorrelation sigma^2 exp(-|dt| / tau) (seed 001).
+// Its state at t = 0 is drawn from the stationary distribution N(0, sigma^2) (the default: the
+// bias of an instrument that has been running), or is 0 (start_at_zero: gnss-ins-sim's
+// pathgen.bias_drift() starts every run there, so its bias variance grows as
+// sigma^2 (1 - exp(-2 t / tau)); set it to reproduce that tool's Monte-Carlo statistics).
 struct GaussMarkovParams {
   double sigma = 0.0;  // [u]
   double tau_s = 0.0;  // [s] correlation time
+  bool start_at_zero = false;
 };
 
 // Flicker (1/f) bias instability, rate PSD S(f) = B^2 / (2 pi f), approximated by a sum of

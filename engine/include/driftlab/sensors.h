@@ -27,7 +27,8 @@
 //   Q        quantization to the LSB `quantization` (increments) or quantization * rate_hz (point
 //            samples), the remainder carried to the next sample, so that the sum of outputs equals
 //            the sum of inputs to within one LSB over any length.
-// Gauss-Markov and flicker states start in their stationary distribution; the random walk at 0.
+// Gauss-Markov and flicker states start in their stationary distribution (the Gauss-Markov bias
+// at 0 instead with GaussMarkovParams::start_at_zero); the random walk at 0.
 //
 // Randomness: every deviate comes from RandomStream(seed, run_index, {sensor, axis, term, ...}) at
 // the index of the step (random.h), so a run's output is a pure function of (model, seed, run,

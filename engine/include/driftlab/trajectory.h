@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -129,20 +130,22 @@ struct FigureEightSegment {
 // For types 2-5 duration_s is the maximum time: the next command starts as soon as the target is
 // reached, or after duration_s if it is not reached by then.
 //
-// How driftlab executes types 2-5 (its own design, see trajectory.cc): each of the six channels
-// (yaw, pitch, roll, v_x, v_y, v_z in the body frame) moves independently from its value at the
-// start of the command to its target. An Euler angle follows a rest-to-rest bang-coast-bang
-// profile: its rate ramps at +-max_angular_acceleration up to at most max_angular_rate, coasts, and
-// ramps back to zero exactly at the target (angle C^1, rate continuous). A body-velocity component
-// changes at the constant acceleration +-max_acceleration until it reaches its target. The command
-// ends when the slowest channel arrives, or is cut at duration_s (the channels then stop where they
-// are and the rates step to those of the next command). Absolute targets are taken literally
-// against the accumulated (unwrapped) Euler angles, as gnss-ins-sim does (target - current).
+// Execution reproduces gnss-ins-sim's own executor (pathgen.py path_gen(), commit 966ff27; see
+// trajectory.cc): a discrete loop at the simulation rate, which is the job's rate_hz as in
+// gnss-ins-sim (its simulation rate is its IMU rate). Type-1 rates and accelerations pass a
+// first-order low-pass filter (0.9 per step); types 2-5 track the target with a low-pass-filtered
+// velocity command and a PD controller on the Euler angles (kp 5, kd 10) under the
+// GnssInsSimLimits, and end early once both |att - target| < 1e-4 rad and |v_b - target| < 1e-4
+// m/s. A command runs at most round(duration_s * rate_hz) steps, so the motion depends on the
+// rate, exactly as gnss-ins-sim's does. Absolute targets are taken literally against the
+// accumulated (unwrapped) Euler angles. The state is held constant-rate over each step and the
+// truth and IMU increments are integrated exactly from those pieces; a motion made only of these
+// commands ends at gnss-ins-sim's last output sample (one step before its executor's last step).
 struct GnssInsSimCommand {
   int type = 1;                           // 1..5, gnss-ins-sim's documented meaning
   Vector3d euler_ypr = Vector3d::Zero();  // rad or rad/s depending on type (yaw, pitch, roll)
   Vector3d v_b = Vector3d::Zero();        // m/s or m/s^2 depending on type
-  double duration_s = 0.0;                // duration (type 1) or maximum duration (types 2-5)
+  double duration_s = 0.0;  // duration (type 1) or maximum duration (types 2-5); 0: no step
   bool gps_visible = true;
   // Where the command came from, e.g. "motion_def.csv:5", used as the field path of errors; empty
   // for commands built in code (then the path is "<motion>.segments[i].gnss_ins_sim").
@@ -156,7 +159,8 @@ struct GnssInsSimCommand {
 // and 2 rad/s (114.6 deg/s). (A user-given mode array is in [m/s^2, deg/s^2, deg/s] and is
 // converted; the README's example passes mode=[1.0, 0.5, 2.0], i.e. 0.5 deg/s^2 and 2 deg/s.)
 // Each limit applies per channel: per body axis for the acceleration, per Euler angle for the
-// angular acceleration and rate (pathgen.py clips each component).
+// angular acceleration and rate (pathgen.py clips each component). Type-1 commands are not
+// limited by them (as in gnss-ins-sim) but must stay below 100 rad/s and 1000 m/s^2.
 struct GnssInsSimLimits {
   double max_acceleration_m_per_s2 = 1.0;
   double max_angular_acceleration_rad_per_s2 = 0.5;
@@ -228,6 +232,10 @@ class TrajectoryGenerator {
   // Times at which the kinematics have a kink (segment boundaries, ramp ends), sorted; interior
   // times only (0 and the end are not listed).
   const std::vector<double>& breakpoints_s() const;
+  // Time windows [start_s, end_s) of the gnss-ins-sim commands whose GPS-visibility column is 0
+  // (the times of their executor steps), ascending and merged, clipped to the duration; empty for
+  // other motions. A job with GNSS aiding turns them into outages.
+  const std::vector<std::pair<double, double>>& gps_invisible_s() const;
   // True while the vehicle is static (speed and angular rate w.r.t. the Earth both exactly zero) at
   // t, in [0, duration]; left-continuous like the point samples (true at the end time of a static
   // segment).
