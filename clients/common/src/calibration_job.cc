@@ -374,9 +374,10 @@ void RunMultiPosition(const CalibrateSettings& s, const NumericTable& table,
 
 calib::BiasModel ParseBiasModel(const std::string& name) {
   if (name == "flicker" || name.empty()) return calib::BiasModel::kFlickerFlat;
+  if (name == "flicker-band") return calib::BiasModel::kFlickerBand;
   if (name == "gauss-markov") return calib::BiasModel::kGaussMarkov;
   if (name == "none") return calib::BiasModel::kNone;
-  throw SpecError("bias_model", "'" + name + "'", "flicker, gauss-markov or none");
+  throw SpecError("bias_model", "'" + name + "'", "flicker, flicker-band, gauss-markov or none");
 }
 
 // SI units of the terms (noise_fit.h model).
@@ -428,7 +429,7 @@ void AddTerms(const calib::NoiseFitResult& fit, bool gyro, const std::string& ax
     if (!row.term->determined && axis == "triad") {
       out->add_messages(
           std::isfinite(row.term->upper_bound)
-              ? fmt::format("{} {} {}: not determined by the data (< {:.3g} {}, about 97.7 % "
+              ? fmt::format("{} {} {}: not determined by the data (< {:.3g} {}, 95 % "
                             "one-sided upper bound)",
                             triad, axis, row.name, row.term->upper_bound, row.unit)
               : fmt::format("{} {} {}: not determined by the data", triad, axis, row.name));
