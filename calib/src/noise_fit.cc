@@ -143,12 +143,11 @@ NoiseTermEstimate* Term(NoiseFitResult& r, int k) {
   }
 }
 
-
 // One weighted least-squares fit of the model with the terms in `active` (the others fixed at 0).
 struct Pass {
   bool ok = false;
-  std::array<double, kTerms> x{};                 // scaled coefficients a_k / s_k
-  std::array<double, kTerms * kTerms> cov_x{};    // their covariance (not inflated)
+  std::array<double, kTerms> x{};               // scaled coefficients a_k / s_k
+  std::array<double, kTerms * kTerms> cov_x{};  // their covariance (not inflated)
   bool has_covariance = false;
   double ln_tau_gm = 0.0;
   double var_ln_tau = NAN;
@@ -402,8 +401,8 @@ NoiseFitResult FitAllanNoiseModel(std::span<const std::vector<AllanPoint>> curve
       without[k] = false;
       Pass reduced = run(without, current.x, current.ln_tau_gm, false);
       // A reduced model that cannot be fitted keeps the term.
-      const double d = reduced.ok ? std::max(0.0, reduced.chi2 - current.chi2) / inflation(current)
-                                  : INFINITY;
+      const double d =
+          reduced.ok ? std::max(0.0, reduced.chi2 - current.chi2) / inflation(current) : INFINITY;
       NoiseTermEstimate& t = *Term(result, k);
       t.lr_statistic = d;
       t.lr_threshold = threshold_of(k);
@@ -446,7 +445,8 @@ NoiseFitResult FitAllanNoiseModel(std::span<const std::vector<AllanPoint>> curve
     if (!active[k]) continue;
     NoiseTermEstimate& t = *Term(result, k);
     const double a = scale[k] * current.x[k];
-    const double sigma_a = scale[k] * std::sqrt(std::max(0.0, current.cov_x[k * kTerms + k]) * infl);
+    const double sigma_a =
+        scale[k] * std::sqrt(std::max(0.0, current.cov_x[k * kTerms + k]) * infl);
     t.determined = true;
     t.value = std::sqrt(std::max(a, 0.0));
     t.sigma = t.value > 0.0 ? sigma_a / (2.0 * t.value) : NAN;  // sigma_c = sigma_a / (2 c)
@@ -586,7 +586,7 @@ std::string FormatNoiseFit(const NoiseFitResult& fit, bool gyro, const TriadErro
   std::string out;
   char line[512];
   std::snprintf(line, sizeof line, "  %-22s %-58s %s\n", "term",
-                "fitted (+- 1 sigma) [95 % interval]; LR test D", 
+                "fitted (+- 1 sigma) [95 % interval]; LR test D",
                 reference != nullptr ? reference_name.c_str() : "");
   out += line;
   for (const Row& row : rows) {
@@ -603,8 +603,8 @@ std::string FormatNoiseFit(const NoiseFitResult& fit, bool gyro, const TriadErro
         fitted += interval;
       }
     } else if (std::isfinite(row.term->upper_bound)) {
-      fitted = "not determined (< " + FormatQuantity(row.term->upper_bound, row.unit, 3) +
-               ", 95 %)";
+      fitted =
+          "not determined (< " + FormatQuantity(row.term->upper_bound, row.unit, 3) + ", 95 %)";
     } else {
       fitted = "not determined";
     }
@@ -629,10 +629,12 @@ std::string FormatNoiseFit(const NoiseFitResult& fit, bool gyro, const TriadErro
     out += line;
   }
   if (fit.quantization.fitted) {
-    out += gyro ? "  quantization Q is the IEEE Std 952 angle quantization coefficient (ADEV = sqrt(3) "
-                  "Q / tau); the angle LSB of a quantizer is sqrt(12) Q (urad)\n"
-                : "  quantization Q is the IEEE Std 952 velocity quantization coefficient (ADEV = "
-                  "sqrt(3) Q / tau); the velocity LSB of a quantizer is sqrt(12) Q (mm/s)\n";
+    out +=
+        gyro
+            ? "  quantization Q is the IEEE Std 952 angle quantization coefficient (ADEV = sqrt(3) "
+              "Q / tau); the angle LSB of a quantizer is sqrt(12) Q (urad)\n"
+            : "  quantization Q is the IEEE Std 952 velocity quantization coefficient (ADEV = "
+              "sqrt(3) Q / tau); the velocity LSB of a quantizer is sqrt(12) Q (mm/s)\n";
   }
   const NoiseTermEstimate* any = &fit.white_noise;
   for (const NoiseTermEstimate* t : {&fit.quantization, &fit.white_noise, &fit.bias_instability,
@@ -640,10 +642,11 @@ std::string FormatNoiseFit(const NoiseFitResult& fit, bool gyro, const TriadErro
     if (std::isfinite(t->lr_threshold)) any = t;
   }
   if (std::isfinite(any->lr_threshold)) {
-    std::snprintf(line, sizeof line,
-                  "  selection: a term is kept when the likelihood-ratio statistic D of dropping it "
-                  "is >= %.3g (chi2_1 mixture at the chosen confidence)\n",
-                  any->lr_threshold);
+    std::snprintf(
+        line, sizeof line,
+        "  selection: a term is kept when the likelihood-ratio statistic D of dropping it "
+        "is >= %.3g (chi2_1 mixture at the chosen confidence)\n",
+        any->lr_threshold);
     out += line;
   }
   std::snprintf(line, sizeof line,

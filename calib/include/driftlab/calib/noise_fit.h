@@ -37,20 +37,24 @@
 // the null value a_k = 0 lies on the boundary, where D_k is distributed as the mixture
 // 1/2 chi2_0 + 1/2 chi2_1 (Chernoff 1954; Self & Liang, JASA 82 (1987) 605, case 1), so the test
 // at false-inclusion rate alpha = 1 - confidence keeps k when D_k >= chi2_1 quantile(1 - 2 alpha)
-// (5.41 at confidence 0.99). The Gauss-Markov bias (sigma and tau leave together) uses chi2_2
-// quantile(confidence). The term with the smallest D_k is dropped and the test repeated until
-// every remaining term passes.
-// Kept terms ("determined") carry sigma and a two-sided 95 % interval of the amplitude from the
-// final fit's covariance (all correlations included, scaled by the reduced chi-square when > 1):
-// [sqrt(max(0, a - 1.96 sigma_a)), sqrt(a + 1.96 sigma_a)]. Dropped terms carry an upper bound
-// c_up = sqrt(max(a, 0) + 1.645 sigma_a) (95 % one-sided) from the last fit that included them.
+// (9.55 at the default confidence 0.999; 5.41 at 0.99). The Gauss-Markov bias (sigma and tau leave
+// together) uses chi2_2 quantile(confidence). The term with the smallest D_k is dropped and the
+// test repeated until every remaining term passes. Kept terms ("determined") carry sigma and a
+// two-sided 95 % interval of the amplitude from the final fit's covariance (all correlations
+// included, scaled by the reduced chi-square when > 1): [sqrt(max(0, a - 1.96 sigma_a)), sqrt(a
+// + 1.96 sigma_a)]. Dropped terms carry an upper bound c_up = sqrt(max(a, 0) + 1.645 sigma_a) (95 %
+// one-sided) from the last fit that included them.
 //
 // Goodness of fit: the fitted curve is compared with each point's 95 % chi-square interval
-// [adev_low, adev_high] (allan.h, NIST SP 1065 section 5.3); a correct model leaves about 5 % of the
-// points outside, so any point outside is counted and reported, and the fit is flagged when the
+// [adev_low, adev_high] (allan.h, NIST SP 1065 section 5.3); a correct model leaves about 5 % of
+// the points outside, so any point outside is counted and reported, and the fit is flagged when the
 // count exceeds the binomial(n, 0.05) 99 % quantile. chi2 = sum r_i^2 is compared with the chi2_dof
 // distribution: outside its [0.1 %, 99.9 %] quantiles the fit is flagged as implausible (too poor:
 // the model misses a feature of the data; too good: the weights are wrong).
+// Known limit: the points are weighted as independent, but overlapping estimates at neighbouring
+// tau share data (and a flicker realisation is correlated across tau), so D and the intervals are
+// optimistic; on 2-hour records spurious Q / K terms are kept in some fits (see
+// tests/calib/noise_fit_static_record_slow_test.cc for the measured rates).
 #pragma once
 
 #include <limits>
@@ -82,17 +86,17 @@ struct NoiseFitOptions {
   bool fit_rate_ramp = true;
   // Confidence of the term-selection test (above): a term absent from the data is kept with
   // probability about 1 - confidence per test.
-  double confidence = 0.99;
+  double confidence = 0.999;
   int max_iterations = 200;
 };
 
 // One fitted term in SI units (see the model above for each term's unit).
 struct NoiseTermEstimate {
-  bool fitted = false;                                      // the term was part of the model
-  bool determined = false;                                  // the data determine it (see above)
-  double value = 0.0;                                       // amplitude; 0 when not determined
-  double sigma = std::numeric_limits<double>::quiet_NaN();  // 1 sigma of value
-  double lower_95 = std::numeric_limits<double>::quiet_NaN();     // 95 % interval (determined)
+  bool fitted = false;                                         // the term was part of the model
+  bool determined = false;                                     // the data determine it (see above)
+  double value = 0.0;                                          // amplitude; 0 when not determined
+  double sigma = std::numeric_limits<double>::quiet_NaN();     // 1 sigma of value
+  double lower_95 = std::numeric_limits<double>::quiet_NaN();  // 95 % interval (determined)
   double upper_95 = std::numeric_limits<double>::quiet_NaN();
   double upper_bound = std::numeric_limits<double>::quiet_NaN();  // 95 % bound (not determined)
   // Likelihood-ratio statistic D_k of the term (above) when it was last tested, and the threshold.
@@ -118,11 +122,11 @@ struct NoiseFitResult {
   int passes = 0;             // fits run (selection included)
   double fit_time_s = 0.0;
   // Goodness of fit (above).
-  int points_outside_95 = 0;          // points whose 95 % interval excludes the fitted curve
-  double expected_outside_95 = 0.0;   // 0.05 n_points
-  int max_plausible_outside_95 = 0;   // binomial(n_points, 0.05) 99 % quantile
+  int points_outside_95 = 0;         // points whose 95 % interval excludes the fitted curve
+  double expected_outside_95 = 0.0;  // 0.05 n_points
+  int max_plausible_outside_95 = 0;  // binomial(n_points, 0.05) 99 % quantile
   double chi2 = 0.0;
-  double chi2_low = 0.0;              // chi2_dof 0.1 % and 99.9 % quantiles
+  double chi2_low = 0.0;  // chi2_dof 0.1 % and 99.9 % quantiles
   double chi2_high = 0.0;
   std::vector<double> tau_outside_95_s;  // the taus of the points outside
   std::vector<std::string> warnings;     // one sentence each; empty for a plausible fit
