@@ -5,6 +5,7 @@
 #include <ceres/covariance.h>
 #include <ceres/manifold.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -56,6 +57,8 @@ struct FitPoint {
   double y = 0.0;                      // ln AVAR - b(edf)
   double sigma = 0.0;                  // sqrt(psi'(edf / 2))
   std::array<double, kTerms> basis{};  // f_k(t); the Gauss-Markov slot is computed from tau
+  int curve = 0;                       // index of the curve the point belongs to
+  int64_t m = 0;                       // averaging factor (0 = unknown: uncorrelated)
 };
 
 double GaussMarkovShape(double tau_gm_s, double t) {
@@ -109,6 +112,106 @@ class PointCost final : public ceres::CostFunction {
   bool gauss_markov_;
 };
 
+// Correlation between the overlapping Allan-variance estimates at averaging factors m1 and m2 of
+// one record of white rate noise (white FM), for a record much longer than 2 m. Each estimate is
+// a mean of squares of d_i(m) = sum_k w_m(k - i) y_k (w_m = -1 on [0, m), +1 on [m, 2m)); for
+// Gaussian y, cov(d_i(m1)^2, d_j(m2)^2) = 2 cov(d_i(m1), d_j(m2))^2 (Isserlis), so
+//   rho(m1, m2) = sum_L R12(L)^2 / sqrt(sum_L R11(L)^2 sum_L R22(L)^2),
+// R12(L) = sum_k w_m1(k) w_m2(k + L) (lag cross-correlation of the weight functions). It depends
+// on m2 / m1 and, for small m, on m itself; large m are scaled down to m1 <= 256 keeping the
+// ratio. The same rho serves ln AVAR (first order). Other noise types are more correlated across
+// tau; the white-FM value is a lower bound used everywhere.
+double WhiteFmAvarCorrelation(int64_t m1, int64_t m2) {
+  if (m1 <= 0 || m2 <= 0) return 0.0;
+  if (m1 == m2) return 1.0;
+  if (m1 > m2) std::swap(m1, m2);
+  const double ratio = static_cast<double>(m2) / static_cast<double>(m1);
+  if (ratio > 256.0) return 0.0;  // rho ~ (m1/m2)^1.5 scale: negligible there
+  if (m1 > 256) {
+    m2 = std::max<int64_t>(257, std::llround(256.0 * ratio));
+    m1 = 256;
+  }
+  // sum_L R(L)^2 for the weight functions of ma and mb; R(L) = -S_b(L, L + ma) + S_b(L + ma,
+  // L + 2 ma) with S_b(a, b) the sum of w_mb over [a, b) (a prefix sum): O(ma + mb).
+  const auto sum_r2 = [](int64_t ma, int64_t mb) {
+    const auto prefix = [mb](int64_t k) -> double {  // sum of w_mb over [0, k)
+      k = std::clamp<int64_t>(k, 0, 2 * mb);
+      return k <= mb ? -static_cast<double>(k) : static_cast<double>(k - 2 * mb);
+    };
+    double total = 0.0;
+    for (int64_t lag = -(2 * ma - 1); lag < 2 * mb; ++lag) {
+      const double r =
+          -(prefix(lag + ma) - prefix(lag)) + (prefix(lag + 2 * ma) - prefix(lag + ma));
+      total += r * r;
+    }
+    return total;
+  };
+  return sum_r2(m1, m2) / std::sqrt(sum_r2(m1, m1) * sum_r2(m2, m2));
+}
+
+// All points of one curve with their correlation (generalised least squares): the normalised
+// residuals r_i of PointCost have the correlation matrix C = L L^T; the cost uses L^-1 r, whose
+// components are uncorrelated with unit variance, so chi2 = r^T C^-1 r.
+class CurveCost final : public ceres::CostFunction {
+ public:
+  CurveCost(std::vector<FitPoint> points, const std::array<double, kTerms>& scale,
+            bool gauss_markov, Eigen::MatrixXd l_inverse)
+      : l_inverse_(std::move(l_inverse)), gauss_markov_(gauss_markov) {
+    for (const FitPoint& p : points) {
+      costs_.push_back(std::make_unique<PointCost>(p, scale, gauss_markov));
+    }
+    set_num_residuals(static_cast<int>(costs_.size()));
+    mutable_parameter_block_sizes()->push_back(kTerms);
+    if (gauss_markov_) mutable_parameter_block_sizes()->push_back(1);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const int n = static_cast<int>(costs_.size());
+    Eigen::VectorXd r(n);
+    Eigen::MatrixXd j0(n, kTerms), j1(n, 1);
+    for (int i = 0; i < n; ++i) {
+      double row0[kTerms], row1[1];
+      double* jac[2] = {row0, row1};
+      if (!costs_[i]->Evaluate(parameters, &r[i], jacobians != nullptr ? jac : nullptr)) {
+        return false;
+      }
+      if (jacobians != nullptr) {
+        for (int k = 0; k < kTerms; ++k) j0(i, k) = row0[k];
+        j1(i, 0) = gauss_markov_ ? row1[0] : 0.0;
+      }
+    }
+    Eigen::Map<Eigen::VectorXd>(residuals, n) = l_inverse_ * r;
+    if (jacobians != nullptr) {
+      if (jacobians[0] != nullptr) {
+        Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, kTerms, Eigen::RowMajor>>(
+            jacobians[0], n, kTerms) = l_inverse_ * j0;
+      }
+      if (gauss_markov_ && jacobians[1] != nullptr) {
+        Eigen::Map<Eigen::VectorXd>(jacobians[1], n) = l_inverse_ * j1;
+      }
+    }
+    return true;
+  }
+
+ private:
+  std::vector<std::unique_ptr<PointCost>> costs_;
+  Eigen::MatrixXd l_inverse_;
+  bool gauss_markov_;
+};
+
+// L^-1 of the Cholesky factor of the points' correlation matrix (WhiteFmAvarCorrelation).
+Eigen::MatrixXd InverseCholeskyOfCorrelation(const std::vector<FitPoint>& points) {
+  const int n = static_cast<int>(points.size());
+  Eigen::MatrixXd c(n, n);
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) c(i, j) = WhiteFmAvarCorrelation(points[i].m, points[j].m);
+  }
+  Eigen::LLT<Eigen::MatrixXd> llt(c);
+  if (llt.info() != Eigen::Success) return Eigen::MatrixXd::Identity(n, n);
+  return llt.matrixL().solve(Eigen::MatrixXd::Identity(n, n));
+}
+
 double FlickerShape(BiasModel model, double tau_min_s, double tau_max_s, double t) {
   if (model == BiasModel::kFlickerFlat) return kFlickerFloor;
   const double adev =
@@ -159,6 +262,8 @@ struct Pass {
 
 struct Problem {
   const std::vector<FitPoint>* points = nullptr;
+  std::vector<std::vector<FitPoint>> curves;  // the points by curve
+  std::vector<Eigen::MatrixXd> l_inverse;     // per curve
   std::array<double, kTerms> scale{};
   bool gauss_markov = false;
   double tau_first = 0.0;
@@ -184,12 +289,12 @@ Pass Solve(const Problem& pr, const std::array<bool, kTerms>& active,
   }
   ceres::Problem::Options problem_options;
   ceres::Problem problem(problem_options);
-  for (const FitPoint& p : *pr.points) {
+  for (size_t c = 0; c < pr.curves.size(); ++c) {
+    auto* cost = new CurveCost(pr.curves[c], pr.scale, pr.gauss_markov, pr.l_inverse[c]);
     if (pr.gauss_markov) {
-      problem.AddResidualBlock(new PointCost(p, pr.scale, true), nullptr, pass.x.data(),
-                               &pass.ln_tau_gm);
+      problem.AddResidualBlock(cost, nullptr, pass.x.data(), &pass.ln_tau_gm);
     } else {
-      problem.AddResidualBlock(new PointCost(p, pr.scale, false), nullptr, pass.x.data());
+      problem.AddResidualBlock(cost, nullptr, pass.x.data());
     }
   }
   std::vector<int> fixed;
@@ -316,8 +421,8 @@ NoiseFitResult FitAllanNoiseModel(std::span<const std::vector<AllanPoint>> curve
   const bool gauss_markov = options.bias_model == BiasModel::kGaussMarkov;
 
   std::vector<FitPoint> points;
-  for (const auto& c : curves) {
-    for (const AllanPoint& p : c) {
+  for (size_t ci = 0; ci < curves.size(); ++ci) {
+    for (const AllanPoint& p : curves[ci]) {
       if (!(p.edf > 0.0 && p.adev > 0.0 && std::isfinite(p.adev) && p.tau_s > 0.0)) continue;
       FitPoint fp;
       fp.tau_s = p.tau_s;
@@ -326,6 +431,8 @@ NoiseFitResult FitAllanNoiseModel(std::span<const std::vector<AllanPoint>> curve
       fp.sigma = std::sqrt(Trigamma(half_edf));
       fp.basis =
           Basis(options.bias_model, result.flicker_tau_min_s, result.flicker_tau_max_s, p.tau_s);
+      fp.curve = static_cast<int>(ci);
+      fp.m = p.m;
       points.push_back(fp);
     }
   }
@@ -349,7 +456,12 @@ NoiseFitResult FitAllanNoiseModel(std::span<const std::vector<AllanPoint>> curve
     }
     if (!std::isfinite(scale[k]) || !(scale[k] > 0.0)) active[k] = false;
   }
-  const Problem problem{&points, scale, gauss_markov, tau_first, tau_last, options.max_iterations};
+  Problem problem{&points,      {},        {},       scale,
+                  gauss_markov, tau_first, tau_last, options.max_iterations};
+  problem.curves.resize(curves.size());
+  for (const FitPoint& p : points) problem.curves[p.curve].push_back(p);
+  std::erase_if(problem.curves, [](const std::vector<FitPoint>& c) { return c.empty(); });
+  for (const auto& c : problem.curves) problem.l_inverse.push_back(InverseCholeskyOfCorrelation(c));
   const int n_points = static_cast<int>(points.size());
   const auto check_size = [&](int n_parameters) {
     if (n_points <= n_parameters) {

@@ -21,13 +21,19 @@
 // weights every tau by its confidence: AVAR_i edf_i / AVAR is chi-square with edf_i degrees of
 // freedom, so var(ln AVAR_i) = psi'(edf/2) ~ 2 / edf and E[ln AVAR_i] - ln AVAR = psi(edf/2) -
 // ln(edf/2) = b(edf) ~ -1/edf (bias removed; NIST SP 1065 section 5.3 for the chi-square model).
+// The points of one curve are not independent: overlapping estimates at neighbouring tau share
+// data. The fit is a generalised least squares: the r_i of one curve are whitened with the
+// Cholesky factor of their correlation matrix, rho(m_i, m_j) of the overlapping Allan variance of
+// white rate noise (computed exactly from the estimator's weights, noise_fit.cc
+// WhiteFmAvarCorrelation; points without m, e.g. synthetic curves, count as independent), so
+// chi2 = r^T C^-1 r. Curves (axes) are independent of each other.
 // Uncertainties: ceres::Covariance of the coefficients, scaled by the reduced chi-square when it
-// exceeds 1 (the octave-spaced ADEV points are not independent, which this partly absorbs); a
-// term's amplitude c = sqrt(a) has sigma_c = sigma_a / (2 c).
+// exceeds 1; a term's amplitude c = sqrt(a) has sigma_c = sigma_a / (2 c).
 //
 // Term selection (which terms the data support), a nested-model likelihood-ratio test by backward
-// elimination: with chi2(M) = sum r_i^2 of the best fit of model M (the r_i are approximately
-// standard normal, so -2 ln L = chi2 + const), dropping term k from the current model M gives
+// elimination: with chi2(M) the (whitened) chi-square of the best fit of model M (the whitened
+// residuals are approximately independent standard normal, so -2 ln L = chi2 + const), dropping
+// term k from the current model M gives
 //   D_k = [chi2(M without k) - chi2(M)] / max(1, chi2(M) / dof(M)),
 // the likelihood-ratio statistic (Wilks 1938; Casella & Berger, Statistical Inference, 2nd ed.,
 // section 10.3.1), scaled by the residual variance when the fit is worse than its weights say
@@ -51,10 +57,10 @@
 // count exceeds the binomial(n, 0.05) 99 % quantile. chi2 = sum r_i^2 is compared with the chi2_dof
 // distribution: outside its [0.1 %, 99.9 %] quantiles the fit is flagged as implausible (too poor:
 // the model misses a feature of the data; too good: the weights are wrong).
-// Known limit: the points are weighted as independent, but overlapping estimates at neighbouring
-// tau share data (and a flicker realisation is correlated across tau), so D and the intervals are
-// optimistic; on 2-hour records spurious Q / K terms are kept in some fits (see
-// tests/calib/noise_fit_static_record_slow_test.cc for the measured rates).
+// Known limit: the whitening uses the white-FM correlation everywhere; where flicker dominates the
+// points are more correlated, so D is overstated there. On 2-hour records of sensors whose floor
+// appears only in the last octaves, B is sometimes dropped or replaced by K (measured rates in
+// tests/calib/noise_fit_static_record_slow_test.cc).
 #pragma once
 
 #include <limits>
