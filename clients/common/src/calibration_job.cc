@@ -622,6 +622,14 @@ v1::NoiseModelFit RunNoiseFit(const NoiseFitSettings& settings, const NumericTab
                     gyro ? "gyro" : "accelerometer", curves.size(),
                     calib::FormatNoiseFit(triad, gyro, reference,
                                           datasheet ? "datasheet " + datasheet->model.name : "")));
+    if (triad.quantization.determined && fit_options.bias_model == calib::BiasModel::kFlickerFlat) {
+      notes.push_back(fmt::format(
+          "{} triad: quantization kept beside the flat flicker floor. If the bias instability is "
+          "band-limited (driftlab's presets: flicker over 1-1000 s), the flat floor over-predicts "
+          "below the band, the fit lowers N and Q absorbs the short-tau excess; check with "
+          "--bias-model flicker-band --flicker-tau-min T1 --flicker-tau-max T2.",
+          gyro ? "gyro" : "accel"));
+    }
     if (triad.rate_ramp.determined) {
       notes.push_back(
           fmt::format("{} triad: the rate ramp has no term in the sensor model; it is not written.",
