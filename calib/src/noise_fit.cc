@@ -122,7 +122,7 @@ class PointCost final : public ceres::CostFunction {
 // ratio. The same rho serves ln AVAR (first order). Other noise types are more correlated across
 // tau; the white-FM value is a lower bound used everywhere.
 double WhiteFmAvarCorrelation(int64_t m1, int64_t m2) {
-  if (m1 <= 0 || m2 <= 0) return 0.0;
+  if (m1 <= 0 || m2 <= 0) return 0.0;  // unknown m: independent
   if (m1 == m2) return 1.0;
   if (m1 > m2) std::swap(m1, m2);
   const double ratio = static_cast<double>(m2) / static_cast<double>(m1);
@@ -205,7 +205,9 @@ Eigen::MatrixXd InverseCholeskyOfCorrelation(const std::vector<FitPoint>& points
   const int n = static_cast<int>(points.size());
   Eigen::MatrixXd c(n, n);
   for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) c(i, j) = WhiteFmAvarCorrelation(points[i].m, points[j].m);
+    for (int j = 0; j < n; ++j) {
+      c(i, j) = i == j ? 1.0 : WhiteFmAvarCorrelation(points[i].m, points[j].m);
+    }
   }
   Eigen::LLT<Eigen::MatrixXd> llt(c);
   if (llt.info() != Eigen::Success) return Eigen::MatrixXd::Identity(n, n);
@@ -454,7 +456,10 @@ NoiseFitResult FitAllanNoiseModel(std::span<const std::vector<AllanPoint>> curve
           (k == kB && gauss_markov) ? GaussMarkovShape(std::exp(ln_tau_gm), p.tau_s) : p.basis[k];
       if (f > 0.0) scale[k] = std::min(scale[k], std::exp(p.y) / f);
     }
-    if (!std::isfinite(scale[k]) || !(scale[k] > 0.0)) active[k] = false;
+    if (!std::isfinite(scale[k]) || !(scale[k] > 0.0)) {
+      active[k] = false;
+      scale[k] = 1.0;  // the term is fixed at 0; a finite scale keeps 0 * f finite
+    }
   }
   Problem problem{&points,      {},        {},       scale,
                   gauss_markov, tau_first, tau_last, options.max_iterations};
