@@ -15,7 +15,7 @@
 // the binomial(n, 0.05) 99.9 % quantile (n = 2 terms x 2 triads x seeds x presets).
 // Run time: the simulation dominates (7.2e5 steps per record); under DRIFTLAB_SANITIZE 3 seeds.
 //
-// DISABLED: the method does not meet every assertion yet. Measured (RelWithDebInfo, default
+// Measured (RelWithDebInfo, default
 // confidence 0.999, generalised least squares; 41 s CPU on one core for the 30 records; run with
 // --gtest_also_run_disabled_tests --gtest_filter='*StaticRecord*'):
 //   preset / triad     N/preset mean  B/preset mean (range)   B not kept  spurious term kept
@@ -27,12 +27,14 @@
 //   tactical accel     1.0007         0.999 (0.996-1.003)     0           0 (max D 8.02)
 //   preset values outside their 95 % interval: 10 of 120 (expected 6, binomial 99.9 % bound 14);
 //   every kept B and every N inside its 99.9 % interval.
-// What fails: where the white noise meets the flicker floor only at ~700 s (stim300 gyro,
-// adis16470 accel: floor 0.664 B reached at tau ~ (N / 0.664 B)^2), a 2-hour record shows the floor
-// in its last 2-3 octaves (edf 2-15), where the band-limited flicker (1-1000 s) bends down and a
-// random walk K fits that realisation as well or better; B is then dropped (with its upper bound)
-// or replaced by K. The whitening uses the white-FM correlation, a lower bound where flicker
-// dominates, so D there is still somewhat overstated.
+// PresetTermsRecoveredAndNoAbsentTermReported runs the four triads that pass (stim300 accel,
+// adis16470 gyro, tactical gyro and accel); DISABLED_LateFloorTriadsBiasInstabilityRecovered
+// keeps the two that do not. What fails there: where the white noise meets the flicker floor only
+// at ~700 s (stim300 gyro, adis16470 accel: floor 0.664 B reached at tau ~ (N / 0.664 B)^2), a
+// 2-hour record shows the floor in its last 2-3 octaves (edf 2-15), where the band-limited flicker
+// (1-1000 s) bends down and a random walk K fits that realisation as well or better; B is then
+// dropped (with its upper bound) or replaced by K. The whitening uses the white-FM correlation, a
+// lower bound where flicker dominates, so D there is still somewhat overstated.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -98,10 +100,17 @@ int BinomialQuantile(int n, double p, double q) {
   return k;
 }
 
-TEST(NoiseFitStaticRecordSlowTest, DISABLED_PresetTermsRecoveredAndNoAbsentTermReported) {
+struct Case {
+  const char* preset;
+  bool gyro;
+  bool accel;
+};
+
+void CheckPresets(const std::vector<Case>& cases) {
   const auto start = std::chrono::steady_clock::now();
   int checks = 0, outside_95 = 0;
-  for (const char* name : {"stim300", "adis16470", "tactical"}) {
+  for (const Case& c : cases) {
+    const char* name = c.preset;
     const ImuErrorModel& preset = FindImuPreset(name);
     struct Summary {
       double n_sum = 0, b_sum = 0, b_min = INFINITY, b_max = 0, d_b_min = INFINITY;
@@ -112,6 +121,7 @@ TEST(NoiseFitStaticRecordSlowTest, DISABLED_PresetTermsRecoveredAndNoAbsentTermR
     for (int s = 0; s < kSeeds; ++s) {
       const Record record = SimulateStatic(preset, kSeedList[s]);
       for (const bool gyro : {true, false}) {
+        if (!(gyro ? c.gyro : c.accel)) continue;
         const TriadErrorParams& truth = gyro ? preset.gyro : preset.accel;
         Summary& sum = summary[gyro ? 0 : 1];
         NoiseFitOptions options;
@@ -159,6 +169,7 @@ TEST(NoiseFitStaticRecordSlowTest, DISABLED_PresetTermsRecoveredAndNoAbsentTermR
       }
     }
     for (const bool gyro : {true, false}) {
+      if (!(gyro ? c.gyro : c.accel)) continue;
       const Summary& sum = summary[gyro ? 0 : 1];
       std::printf(
           "%-9s %s: %d seeds: N/preset mean %.4f (%d outside 95 %% CI), B/preset mean %.3f "
@@ -175,6 +186,16 @@ TEST(NoiseFitStaticRecordSlowTest, DISABLED_PresetTermsRecoveredAndNoAbsentTermR
       outside_95, checks, 0.05 * checks, allowed,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   EXPECT_LE(outside_95, allowed);
+}
+
+// The triads that meet the assertions at 2 hours (white noise meets the flicker floor by ~100 s).
+TEST(NoiseFitStaticRecordSlowTest, PresetTermsRecoveredAndNoAbsentTermReported) {
+  CheckPresets({{"stim300", false, true}, {"adis16470", true, false}, {"tactical", true, true}});
+}
+
+// The two triads whose floor shows only in the record's last octaves (see the header comment).
+TEST(NoiseFitStaticRecordSlowTest, DISABLED_LateFloorTriadsBiasInstabilityRecovered) {
+  CheckPresets({{"stim300", true, false}, {"adis16470", false, true}});
 }
 
 }  // namespace
