@@ -305,12 +305,17 @@ const RegisterCommand kAllan("allan", [](CLI::App& app) -> std::function<int()> 
                       "With --fit: a datasheet summary to compare with side by side");
   command
       ->add_option("--bias-model", options->fit_options.bias_model,
-                   "With --fit: flicker, gauss-markov or none")
+                   "With --fit: flicker (IEEE flat floor), flicker-band (the engine's band-limited "
+                   "flicker over --flicker-tau-min..max, what driftlab's presets simulate), "
+                   "gauss-markov or none")
       ->capture_default_str();
   command->add_option("--flicker-tau-min", options->fit_options.flicker_tau_min_s,
                       "With --fit: flicker band start [s] (0 = first tau)");
   command->add_option("--flicker-tau-max", options->fit_options.flicker_tau_max_s,
                       "With --fit: flicker band end [s] (0 = last tau)");
+  command->add_option("--fit-json", options->fit_options.fit_json_path,
+                      "With --fit: the whole fit as JSON (terms with 95 % intervals and the "
+                      "selection test, goodness of fit per fit, warnings)");
   command->add_option("--report", options->report_path,
                       "With --fit: self-contained HTML report (ADEV with 95 % CIs and the fitted "
                       "curve per column, fitted terms, the model)");
@@ -321,6 +326,11 @@ const RegisterCommand kAllan("allan", [](CLI::App& app) -> std::function<int()> 
                    "error: --report: {} is not allowed; allowed: with --fit (the report shows "
                    "the noise-model fit)\n",
                    options->report_path);
+        return kExitBadJob;
+      }
+      if (!options->fit_options.fit_json_path.empty()) {
+        fmt::print(stderr, "error: --fit-json: {} is not allowed; allowed: with --fit\n",
+                   options->fit_options.fit_json_path);
         return kExitBadJob;
       }
       return RunAllan(*options);

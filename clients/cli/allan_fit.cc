@@ -78,7 +78,24 @@ int RunAllanFit(const AllanFitOptions& options) {
   for (const std::string& m : fit.messages()) {
     fmt::print("{}{}", m, !m.empty() && m.back() == '\n' ? "" : "\n");
   }
+  if (fit.warnings_size() > 0) {
+    fmt::print("{} warning(s) about the fit (also in --fit-json):\n", fit.warnings_size());
+    for (const std::string& w : fit.warnings()) fmt::print("  WARNING {}\n", w);
+  }
   fmt::print("fit time {:.3f} s\n", fit.fit_time_s());
+  if (!options.fit_json_path.empty()) {
+    google::protobuf::util::JsonPrintOptions print;
+    print.add_whitespace = true;
+    print.preserve_proto_field_names = true;
+    std::string json;
+    if (!google::protobuf::util::MessageToJsonString(fit, &json, print).ok()) {
+      fmt::print(stderr, "error: cannot convert the fit to JSON\n");
+      return kExitFailure;
+    }
+    if (const int status = WriteOutputText(options.fit_json_path, json, "--fit-json")) {
+      return status;
+    }
+  }
   if (!options.out_path.empty()) {
     v1::Job job;
     *job.mutable_sensor() = fit.sensor();

@@ -22,9 +22,11 @@ struct AllanFitOptions {
   std::string columns;
   std::string out_path;        // MODEL.json ({"sensor": {...}}); empty = not written
   std::string report_path;     // REPORT.html; empty = not written
+  std::string fit_json_path;   // FIT.json: the whole v1.NoiseModelFit (terms with intervals and
+                               // tests, goodness of fit, warnings); empty = not written
   std::string datasheet_path;  // datasheet summary to compare with (calib/datasheet.h)
   int points_per_octave = 1;
-  std::string bias_model = "flicker";  // flicker | gauss-markov | none
+  std::string bias_model = "flicker";  // flicker | flicker-band | gauss-markov | none
   double flicker_tau_min_s = 0.0;      // 0 = first tau of the curve
   double flicker_tau_max_s = 0.0;      // 0 = last tau
 };

@@ -105,8 +105,8 @@ TEST_P(GradePresetNoiseFit, WhiteNoiseWithin5PercentBiasInstabilityWithin15Perce
       ASSERT_TRUE(fit.bias_instability.determined);
       EXPECT_LT(std::fabs(n_error), 0.05) << c.preset << (gyro ? " gyro" : " accel") << a;
       EXPECT_LT(std::fabs(b_error), 0.15) << c.preset << (gyro ? " gyro" : " accel") << a;
-      // The grade presets have no random walk: the fit must not invent one (3-sigma rule,
-      // ~0.1 % false detection per fit).
+      // The grade presets have no random walk: the fit must not invent one (likelihood-ratio
+      // selection at confidence 0.999, noise_fit.h: ~0.1 % false inclusion per test).
       EXPECT_FALSE(fit.random_walk.determined) << c.preset << (gyro ? " gyro" : " accel") << a;
     }
   }

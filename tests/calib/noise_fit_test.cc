@@ -192,5 +192,55 @@ TEST(NoiseFitTest, UnusableCurvesAreRejectedWithAMessage) {
   EXPECT_THROW(FitAllanNoiseModel(flat, options), SpecError);
 }
 
+TEST(NoiseFitTest, SelectionThresholdIsTheBoundaryMixtureQuantile) {
+  // Default confidence 0.999: chi2_1 quantile at 1 - 2 (0.001) = z_0.999^2 = 3.090232^2 = 9.5495
+  // (normal table); the tolerance covers the 4 printed digits of z.
+  const double N = 0.15 * kDegPerSqrtH, B = 3.0 * kDegPerH;
+  const auto curve = ExactCurve(
+      [&](double t) {
+        return AllanCurveModel(t, N, B, 0, 0, 0) * AllanCurveModel(t, N, B, 0, 0, 0);
+      },
+      0.01, 1e4, 1e3);
+  const NoiseFitResult fit = FitAllanNoiseModel(curve);
+  for (const NoiseTermEstimate* t : {&fit.quantization, &fit.white_noise, &fit.bias_instability,
+                                     &fit.random_walk, &fit.rate_ramp}) {
+    ASSERT_TRUE(std::isfinite(t->lr_threshold));
+    EXPECT_NEAR(t->lr_threshold, 9.5495, 1e-3);
+    // A kept term's test passed, a dropped term's failed.
+    EXPECT_EQ(t->determined, t->lr_statistic >= t->lr_threshold);
+  }
+  EXPECT_TRUE(fit.white_noise.determined);
+  EXPECT_TRUE(fit.bias_instability.determined);
+  // Kept terms carry a 95 % interval around the value.
+  EXPECT_LE(fit.bias_instability.lower_95, fit.bias_instability.value);
+  EXPECT_GE(fit.bias_instability.upper_95, fit.bias_instability.value);
+}
+
+TEST(NoiseFitTest, CurveLeavingItsIntervalsIsFlagged) {
+  // White noise plus a rate random walk that dominates from ~100 s, fitted with white noise only:
+  // at the long taus the model lies far below the data (edf 1e3: bars +-9 %), so more points
+  // fall outside than the binomial 99 % bound and chi2 exceeds its 99.9 % quantile.
+  const double N = 0.15 * kDegPerSqrtH, K = 20.0 * kDegPerH / 60.0;
+  const auto curve = ExactCurve(
+      [&](double t) {
+        return AllanCurveModel(t, N, 0, K, 0, 0) * AllanCurveModel(t, N, 0, K, 0, 0);
+      },
+      0.01, 1e4, 1e3);
+  NoiseFitOptions options;
+  options.bias_model = BiasModel::kNone;
+  options.fit_quantization = false;
+  options.fit_random_walk = false;
+  options.fit_rate_ramp = false;
+  const NoiseFitResult fit = FitAllanNoiseModel(curve, options);
+  EXPECT_GT(fit.points_outside_95, fit.max_plausible_outside_95);
+  EXPECT_GT(fit.chi2, fit.chi2_high);
+  EXPECT_EQ(fit.warnings.size(), 2u);
+  // With the random walk allowed the same curve fits: no point outside (exact data).
+  options.fit_random_walk = true;
+  const NoiseFitResult good = FitAllanNoiseModel(curve, options);
+  EXPECT_TRUE(good.random_walk.determined);
+  EXPECT_EQ(good.points_outside_95, 0);
+}
+
 }  // namespace
 }  // namespace driftlab::calib

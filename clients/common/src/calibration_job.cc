@@ -374,9 +374,10 @@ void RunMultiPosition(const CalibrateSettings& s, const NumericTable& table,
 
 calib::BiasModel ParseBiasModel(const std::string& name) {
   if (name == "flicker" || name.empty()) return calib::BiasModel::kFlickerFlat;
+  if (name == "flicker-band") return calib::BiasModel::kFlickerBand;
   if (name == "gauss-markov") return calib::BiasModel::kGaussMarkov;
   if (name == "none") return calib::BiasModel::kNone;
-  throw SpecError("bias_model", "'" + name + "'", "flicker, gauss-markov or none");
+  throw SpecError("bias_model", "'" + name + "'", "flicker, flicker-band, gauss-markov or none");
 }
 
 // SI units of the terms (noise_fit.h model).
@@ -415,6 +416,22 @@ void AddTerms(const calib::NoiseFitResult& fit, bool gyro, const std::string& ax
       {"rate_ramp", &fit.rate_ramp, u.ramp, 0},
   };
   const char* triad = gyro ? "gyro" : "accel";
+  v1::NoiseFitQuality* q = out->add_quality();
+  q->set_triad(triad);
+  q->set_axis(axis);
+  q->set_points(fit.n_points);
+  q->set_points_outside_95(fit.points_outside_95);
+  q->set_expected_outside_95(fit.expected_outside_95);
+  q->set_max_plausible_outside_95(fit.max_plausible_outside_95);
+  for (const double tau : fit.tau_outside_95_s) q->add_tau_outside_95_s(tau);
+  q->set_chi2(fit.chi2);
+  q->set_dof(fit.n_points - fit.n_parameters);
+  q->set_chi2_low(fit.chi2_low);
+  q->set_chi2_high(fit.chi2_high);
+  for (const std::string& w : fit.warnings) {
+    q->add_warnings(w);
+    out->add_warnings(fmt::format("{} {}: {}", triad, axis, w));
+  }
   for (const Row& row : rows) {
     if (!row.term->fitted) continue;
     v1::NoiseTerm* t = out->add_terms();
@@ -424,11 +441,17 @@ void AddTerms(const calib::NoiseFitResult& fit, bool gyro, const std::string& ax
     t->set_unit(row.unit);
     t->set_value(row.term->determined ? row.term->value : 0.0);
     t->set_sigma(row.term->determined ? row.term->sigma : NAN);
+    t->set_determined(row.term->determined);
+    t->set_lower_95(row.term->lower_95);
+    t->set_upper_95(row.term->upper_95);
+    t->set_upper_bound(row.term->upper_bound);
+    t->set_lr_statistic(row.term->lr_statistic);
+    t->set_lr_threshold(row.term->lr_threshold);
     if (datasheet != nullptr && row.datasheet > 0.0) t->set_datasheet_value(row.datasheet);
     if (!row.term->determined && axis == "triad") {
       out->add_messages(
           std::isfinite(row.term->upper_bound)
-              ? fmt::format("{} {} {}: not determined by the data (< {:.3g} {}, about 97.7 % "
+              ? fmt::format("{} {} {}: not determined by the data (< {:.3g} {}, 95 % "
                             "one-sided upper bound)",
                             triad, axis, row.name, row.term->upper_bound, row.unit)
               : fmt::format("{} {} {}: not determined by the data", triad, axis, row.name));
@@ -599,6 +622,14 @@ v1::NoiseModelFit RunNoiseFit(const NoiseFitSettings& settings, const NumericTab
                     gyro ? "gyro" : "accelerometer", curves.size(),
                     calib::FormatNoiseFit(triad, gyro, reference,
                                           datasheet ? "datasheet " + datasheet->model.name : "")));
+    if (triad.quantization.determined && fit_options.bias_model == calib::BiasModel::kFlickerFlat) {
+      notes.push_back(fmt::format(
+          "{} triad: quantization kept beside the flat flicker floor. If the bias instability is "
+          "band-limited (driftlab's presets: flicker over 1-1000 s), the flat floor over-predicts "
+          "below the band, the fit lowers N and Q absorbs the short-tau excess; check with "
+          "--bias-model flicker-band --flicker-tau-min T1 --flicker-tau-max T2.",
+          gyro ? "gyro" : "accel"));
+    }
     if (triad.rate_ramp.determined) {
       notes.push_back(
           fmt::format("{} triad: the rate ramp has no term in the sensor model; it is not written.",
