@@ -1,12 +1,16 @@
-// Helpers shared by the fuzz targets (fuzz_targets.h).
+// Helpers shared by the fuzz targets (fuzz_targets.h); header-only, so a target links only the
+// libraries of the reader it fuzzes.
 #pragma once
+
+#include <unistd.h>
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <string_view>
-
-#include "driftlab/v1/job.pb.h"
 
 namespace driftlab::fuzz {
 
@@ -18,11 +22,15 @@ inline std::string_view AsText(const uint8_t* data, size_t size) {
 // Writes the input to this process's scratch file (in the system's temporary directory, one per
 // process and `suffix`, rewritten on every call) and returns its path, for the readers that take
 // a path, as the CLI calls them.
-std::string WriteScratchFile(const uint8_t* data, size_t size, std::string_view suffix);
-
-// What `validate` and `run` do with a parsed job: ValidateJob (motion files relative to a
-// directory that does not exist), then ToMonteCarloSpec with the default limits. SpecError
-// (LimitError included) is the expected refusal and is caught.
-void ValidateParsedJob(const v1::Job& job);
+inline std::string WriteScratchFile(const uint8_t* data, size_t size, std::string_view suffix) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("driftlab-fuzz-" + std::to_string(::getpid()) + std::string(suffix)))
+                               .string();
+  std::FILE* file = std::fopen(path.c_str(), "wb");
+  if (file == nullptr) throw std::runtime_error("fuzz: cannot create " + path);
+  const bool ok = std::fwrite(data, 1, size, file) == size;
+  if (std::fclose(file) != 0 || !ok) throw std::runtime_error("fuzz: cannot write " + path);
+  return path;
+}
 
 }  // namespace driftlab::fuzz

@@ -3,6 +3,7 @@
 #include "driftlab/spec_error.h"
 #include "fuzz_support.h"
 #include "fuzz_targets.h"
+#include "job_validation.h"
 
 namespace driftlab::fuzz {
 

@@ -7,9 +7,9 @@
 fuzz_build_dir="${DRIFTLAB_FUZZ_BUILD_DIR:-build-fuzz}"
 fuzz_cxx="${DRIFTLAB_FUZZ_CXX:-clang++-14}"
 
-# The target names, from fuzz/CMakeLists.txt (name:Function entries).
+# The target names, from fuzz/CMakeLists.txt (name:Function:library entries).
 fuzz_targets() {
-  sed -n 's/^ *\([a-z_]*\):Fuzz[A-Za-z]*)\{0,1\}$/\1/p' fuzz/CMakeLists.txt
+  sed -n 's/^ *\([a-z_]*\):Fuzz[A-Za-z]*:.*/\1/p' fuzz/CMakeLists.txt
 }
 
 # True when clang++-14 can build and link a libFuzzer program (the compiler and its runtime,
