@@ -1,15 +1,19 @@
 #!/usr/bin/env bash
 # A measured fuzzing campaign of one target: fuzz/measure.sh TARGET CPU_SECONDS
-# Runs TARGET under `nice -n 19` in libFuzzer's fork mode (crashes, timeouts and memory blow-ups
-# are recorded in build-fuzz/artifacts/TARGET/ and the run goes on) until the process tree has
-# used CPU_SECONDS of CPU time, then prints one line: target, CPU seconds, executions, findings
-# (artifact files), and libFuzzer's last cov:/ft: figures. The log is build-fuzz/logs/TARGET.measure.log.
+# Runs TARGET (built by fuzz/ci.sh or fuzz/run.sh) under `nice -n 19` in libFuzzer's fork mode
+# (crashes, timeouts and memory blow-ups are recorded in build-fuzz/artifacts/TARGET/ and the run
+# goes on) until the process tree has used CPU_SECONDS of CPU time, then prints one line: target,
+# CPU seconds, executions, findings (artifact files), and libFuzzer's last cov:/ft: figures.
+# The log is build-fuzz/logs/TARGET.measure.log.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source fuzz/lib.sh
 
 target="$1" cpu_budget_s="$2"
-fuzz_build > /dev/null
+if [ ! -x "$fuzz_build_dir/fuzz/${target}_fuzzer" ]; then
+  echo "fuzz/measure.sh: build the targets first (fuzz/ci.sh or fuzz/run.sh)" >&2
+  exit 1
+fi
 logs="$fuzz_build_dir/logs"
 mkdir -p "$logs"
 log="$logs/$target.measure.log"
