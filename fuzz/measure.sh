@@ -47,7 +47,10 @@ ticks=0
 while kill -0 "$leader" 2> /dev/null; do
   ticks=$(tree_ticks "$leader")
   if [ "$ticks" -ge $((cpu_budget_s * ticks_per_s)) ]; then
+    # libFuzzer's fork-mode parent outlives SIGINT and SIGTERM (LLVM 14): stop the group.
     kill -INT -- "-$leader" 2> /dev/null || true
+    sleep 3
+    kill -KILL -- "-$leader" 2> /dev/null || true
     break
   fi
   sleep 2
