@@ -10,6 +10,7 @@
 #include <set>
 #include <sstream>
 
+#include "driftlab/calib/yaml_document.h"
 #include "driftlab/input_files.h"
 #include "driftlab/sensors.h"
 #include "driftlab/spec_error.h"
@@ -143,24 +144,26 @@ std::string SiUnitText(Dimension d) {
 // the structure is fixed (a mapping of name, description, gyro, accel; gyro and accel mappings of
 // scalars), so nothing is walked beyond two levels and aliases cannot expand it.
 std::vector<DatasheetEntry> ParseDatasheetText(std::string_view text, std::string_view source) {
-  std::vector<YAML::Node> documents;
+  YamlDocuments documents;
   try {
-    documents = YAML::LoadAll(std::string(text));
+    documents = LoadYamlDocuments(text);
   } catch (const YAML::Exception& e) {
     throw SpecError(Where(source, e.mark.line + 1), "invalid YAML (" + e.msg + ")",
                     "a YAML mapping of name, description, gyro, "
                     "accel");
   }
-  if (documents.size() != 1 || !documents.front().IsMap() || documents.front().size() == 0) {
-    const bool empty = documents.empty() || (documents.size() == 1 && documents.front().IsNull());
+  if (documents.count != 1 || !documents.first.IsMap() || documents.first.size() == 0) {
+    const bool empty = documents.count == 0 || (documents.count == 1 && documents.first.IsNull());
     throw SpecError(std::string(source),
-                    empty                  ? std::string("an empty datasheet")
-                    : documents.size() > 1 ? std::to_string(documents.size()) + " YAML documents"
-                                           : std::string("not a mapping of keys"),
+                    empty ? std::string("an empty datasheet")
+                    : documents.count > 1
+                        ? std::string("more than one YAML document (a --- separator, or a ',' "
+                                      "outside [ ] and { })")
+                        : std::string("not a mapping of keys"),
                     "one YAML document: a mapping of name, description, gyro, accel with at "
                     "least one figure");
   }
-  const YAML::Node& root = documents.front();
+  const YAML::Node& root = documents.first;
   CheckTag(root, source);
   std::vector<DatasheetEntry> entries;
   std::set<std::string> seen;

@@ -96,5 +96,22 @@ TEST(DatasheetTest, BadInputsNameTheKeyTheValueAndTheAllowedUnits) {
                SpecError);  // tau missing
 }
 
+// yaml-cpp's LoadAll never returns on a ',' at a document's top level (yaml_document.h; found by
+// the datasheet fuzz target): such texts are refused, as is a second document.
+TEST(DatasheetTest, StrayTopLevelCommaIsRefusedInsteadOfLoopingForever) {
+  for (const std::string text : {",", "\n,", "# comment\n,", "name: x\n---\n,"}) {
+    try {
+      ParseDatasheetText(text, "t.yaml");
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const SpecError& e) {
+      EXPECT_NE(std::string(e.what()).find("more than one YAML document"), std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_THROW(ParseDatasheetText("gyro: {arw: 0.1 deg/√h}\n---\ngyro: {arw: 0.2 deg/√h}\n", "t"),
+               SpecError);
+  EXPECT_EQ(ParseDatasheetText("gyro: {arw: 0.1 deg/√h}\n", "t").size(), 1u);
+}
+
 }  // namespace
 }  // namespace driftlab::calib

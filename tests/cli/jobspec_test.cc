@@ -346,6 +346,19 @@ TEST(JobSpec, SyntaxErrorsAreOneLineWithTheSource) {
   EXPECT_EQ(YamlError("rate_hz: 1\nrate_hz: 2\n"), "rate_hz: line 2: given twice; allowed: once");
 }
 
+// yaml-cpp's LoadAll never returns on a ',' at a document's top level (calib/yaml_document.h;
+// found by the job_yaml fuzz target): refused like a second document, in bounded time.
+TEST(JobSpec, StrayTopLevelCommaInYamlIsRefusedInsteadOfLoopingForever) {
+  for (const std::string yaml : {",", "rate_hz: 100\n---\n,", "# job\n,\n"}) {
+    EXPECT_EQ(YamlError(yaml),
+              "job: more than one YAML document (a --- separator, or a ',' outside [ ] and { }); "
+              "allowed: one document")
+        << yaml;
+  }
+  EXPECT_NE(YamlError("rate_hz: 100\n---\nrate_hz: 50\n").find("more than one YAML document"),
+            std::string::npos);
+}
+
 TEST(JobSpec, ImportedMotionFileResolvesAgainstTheJobFileDirectory) {
   const JobFile file = LoadJobFile(kExamples / "gnss_ins_sim_import.json");
   EXPECT_EQ(file.base_dir, std::filesystem::absolute(kExamples));

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "driftlab/calib/yaml_document.h"
 #include "driftlab/input_files.h"
 #include "driftlab/jobspec/json_syntax.h"
 #include "driftlab/jobspec/schema_check.h"
@@ -212,24 +213,24 @@ void YamlToValue(const YAML::Node& node, const std::string& path, Value* out, Ya
 }
 
 Value YamlTextToValue(std::string_view yaml_text, std::string_view source) {
-  std::vector<YAML::Node> documents;
+  calib::YamlDocuments documents;
   try {
-    documents = YAML::LoadAll(std::string(yaml_text));
+    documents = calib::LoadYamlDocuments(yaml_text);
   } catch (const YAML::Exception& e) {
     throw SpecError(std::string(source),
                     fmt::format("invalid YAML at line {}, column {}: {}", e.mark.line + 1,
                                 e.mark.column + 1, e.msg),
                     0);
   }
-  if (documents.size() > 1) {
+  if (documents.count > 1) {
     throw SpecError(std::string(source),
-                    fmt::format("{} YAML documents (separated by ---); allowed: one document",
-                                documents.size()),
+                    "more than one YAML document (a --- separator, or a ',' outside [ ] and { }); "
+                    "allowed: one document",
                     0);
   }
   Value value;
   YamlWalk walk{0, source, yaml_text};
-  YamlToValue(documents.empty() ? YAML::Node() : documents.front(), "", &value, &walk, 0);
+  YamlToValue(documents.first, "", &value, &walk, 0);
   return value;
 }
 

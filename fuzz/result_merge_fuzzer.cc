@@ -1,0 +1,55 @@
+// Fuzz target: result files (fuzz_targets.h), as `report`, `gate` and `merge` read them. The input
+// is two result texts separated by a NUL byte (a JSON text holds none): each is parsed and
+// validated (ParseJobResultJson) and rendered (RenderHtmlReport); the pair is gated (RunGate with
+// the default rules, its table and JUnit XML) and merged as two shards (MergeJobResults).
+#include <optional>
+#include <string_view>
+
+#include "driftlab/jobspec/gate.h"
+#include "driftlab/jobspec/html_report.h"
+#include "driftlab/jobspec/monte_carlo_job.h"
+#include "driftlab/jobspec/result_file.h"
+#include "driftlab/spec_error.h"
+#include "fuzz_support.h"
+#include "fuzz_targets.h"
+
+namespace driftlab::fuzz {
+namespace {
+
+std::optional<v1::JobResult> ReadOne(std::string_view text, std::string_view source) {
+  try {
+    v1::JobResult result = jobspec::ParseJobResultJson(text, source);
+    jobspec::RenderHtmlReport(result);
+    return result;
+  } catch (const SpecError&) {
+    return std::nullopt;
+  }
+}
+
+}  // namespace
+
+void FuzzResultMerge(const uint8_t* data, size_t size) {
+  const std::string_view text = AsText(data, size);
+  const size_t nul = text.find('\0');
+  const std::optional<v1::JobResult> first = ReadOne(text.substr(0, nul), "first.json");
+  if (nul == std::string_view::npos) return;
+  const std::optional<v1::JobResult> second = ReadOne(text.substr(nul + 1), "second.json");
+  if (!first || !second) return;
+  try {
+    jobspec::GateOptions options;
+    options.allow_different_job = true;
+    const jobspec::GateReport report =
+        jobspec::RunGate(*first, *second, jobspec::DefaultGateRules(), options);
+    jobspec::FormatGateTable(report);
+    jobspec::RenderJunitXml(report);
+  } catch (const SpecError&) {
+  }
+  try {
+    const v1::JobResult merged =
+        jobspec::MergeJobResults({*first, *second}, {"first.json", "second.json"}, "fuzz");
+    jobspec::ValidateJobResult(merged);
+  } catch (const SpecError&) {
+  }
+}
+
+}  // namespace driftlab::fuzz
