@@ -123,49 +123,6 @@ bool IdentifyNoiseType(const std::vector<double>& x, int64_t m, AllanNoiseType* 
   return true;
 }
 
-// Standard normal quantile, Abramowitz & Stegun 26.2.23 (|error| < 4.5e-4); used only as the
-// starting point of the chi-square quantile iteration.
-double NormalQuantileApprox(double p) {
-  const double q = p < 0.5 ? p : 1.0 - p;
-  const double t = std::sqrt(-2.0 * std::log(q));
-  const double z = t - (2.515517 + 0.802853 * t + 0.010328 * t * t) /
-                           (1.0 + 1.432788 * t + 0.189269 * t * t + 0.001308 * t * t * t);
-  return p < 0.5 ? -z : z;
-}
-
-// Regularized lower incomplete gamma function P(a, x), a > 0, x >= 0: the power series
-//   P = e^-x x^a / Gamma(a + 1) sum_k x^k / ((a + 1) ... (a + k))          for x < a + 1,
-// and otherwise 1 - Q with Q from the Legendre continued fraction evaluated by the modified Lentz
-// method (Abramowitz & Stegun 6.5.29 and 6.5.31; Press et al., Numerical Recipes, 3rd ed., 6.2).
-double RegularizedGammaP(double a, double x) {
-  if (x <= 0.0) return 0.0;
-  const double log_prefactor = a * std::log(x) - x - std::lgamma(a);
-  if (x < a + 1.0) {
-    double term = 1.0 / a, sum = term;
-    for (int k = 1; k < 1000; ++k) {
-      term *= x / (a + k);
-      sum += term;
-      if (std::abs(term) < std::abs(sum) * 1e-16) break;
-    }
-    return sum * std::exp(log_prefactor);
-  }
-  constexpr double kTiny = 1e-300;
-  double b = x + 1.0 - a, c = 1.0 / kTiny, d = 1.0 / b, h = d;
-  for (int i = 1; i < 1000; ++i) {
-    const double an = -i * (i - a);
-    b += 2.0;
-    d = an * d + b;
-    if (std::abs(d) < kTiny) d = kTiny;
-    c = b + an / c;
-    if (std::abs(c) < kTiny) c = kTiny;
-    d = 1.0 / d;
-    const double delta = d * c;
-    h *= delta;
-    if (std::abs(delta - 1.0) < 1e-16) break;
-  }
-  return 1.0 - std::exp(log_prefactor) * h;
-}
-
 // Tau grid: m_j = round(2^(j / ppo)), distinct, 1 <= m <= (n - 1) / 2.
 std::vector<int64_t> AveragingFactors(int64_t n, int points_per_octave) {
   std::vector<int64_t> ms;
@@ -180,40 +137,6 @@ std::vector<int64_t> AveragingFactors(int64_t n, int points_per_octave) {
 }
 
 }  // namespace
-
-double ChiSquareQuantile(double p, double nu) {
-  if (!(p > 0.0 && p < 1.0)) throw SpecError("chi_square.p", std::to_string(p), "(0, 1)");
-  if (!(nu > 0.0 && std::isfinite(nu)))
-    throw SpecError("chi_square.nu", std::to_string(nu), "> 0, finite");
-  const double a = nu / 2.0;
-  auto cdf = [a](double x) { return RegularizedGammaP(a, x / 2.0); };
-  // Wilson & Hilferty (1931): chi2_p(nu) ~ nu (1 - 2/(9 nu) + z_p sqrt(2/(9 nu)))^3.
-  const double k = 2.0 / (9.0 * nu);
-  double x = nu * std::pow(std::max(1.0 - k + NormalQuantileApprox(p) * std::sqrt(k), 1e-3), 3);
-  // Bracket the root of cdf(x) - p, then safeguarded Newton steps (bisection when a step leaves
-  // the bracket). The density is f(x) = exp((a - 1) ln x - x/2 - a ln 2 - lgamma(a)).
-  double lo = 0.0, hi = std::max(x, 1.0);
-  while (cdf(hi) < p) {
-    lo = hi;
-    hi *= 2.0;
-  }
-  if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
-  for (int iter = 0; iter < 200; ++iter) {
-    const double f = cdf(x) - p;
-    if (f < 0.0) {
-      lo = x;
-    } else {
-      hi = x;
-    }
-    const double density =
-        std::exp((a - 1.0) * std::log(x) - x / 2.0 - a * std::log(2.0) - std::lgamma(a));
-    double next = density > 0.0 ? x - f / density : 0.5 * (lo + hi);
-    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-    if (std::abs(next - x) <= 1e-14 * x || hi - lo <= 1e-15 * hi) return next;
-    x = next;
-  }
-  return x;
-}
 
 double OverlappingAdevEdf(AllanNoiseType noise_type, int64_t n_phase, int64_t m) {
   // Howe, Allan & Barnes, "Properties of signal sources and measurement methods", Proc. 35th

@@ -23,6 +23,8 @@
 #include <span>
 #include <vector>
 
+#include "driftlab/special_functions.h"  // ChiSquareQuantile (interval of each point)
+
 namespace driftlab {
 
 // Power-law noise type of the rate signal at one tau, named in the frequency-stability convention
@@ -74,11 +76,6 @@ std::vector<AllanPoint> OverlappingAllanDeviation(std::span<const double> rate_s
 // approximations of Howe, Allan & Barnes (1981), NIST TN 1337 table 12-4, also in NIST SP 1065.
 // n_phase = number of integrated (phase) points = number of rate samples + 1; m = averaging factor.
 double OverlappingAdevEdf(AllanNoiseType noise_type, int64_t n_phase, int64_t m);
-
-// Quantile of the chi-square distribution with nu (real, > 0) degrees of freedom:
-// x such that P(chi2_nu <= x) = p. Wilson-Hilferty start refined by Newton/bisection on the
-// regularized incomplete gamma function P(nu/2, x/2) to ~1e-12 relative accuracy.
-double ChiSquareQuantile(double p, double nu);
 
 // Noise-term read-off from an Allan curve (IEEE Std 952-1997 Annex C, table C.2). For a gyro the
 // rates are rad/s and: N [rad/sqrt(s)], B [rad/s], K [rad/s/sqrt(s)], Q [rad], R [rad/s^2]; for an

@@ -8,11 +8,11 @@
 // below what a gate decision depends on.
 #pragma once
 
-namespace driftlab::jobspec {
+// The incomplete gamma function and the chi-square CDF and quantile are the engine's
+// (driftlab::RegularizedGammaP, ChiSquareCdf, ChiSquareQuantile), found from this namespace.
+#include "driftlab/special_functions.h"
 
-// Regularised lower incomplete gamma P(a, x) = gamma(a, x) / Gamma(a), a > 0, x >= 0
-// (A&S 6.5.1; NR 6.2: series 6.2.5 for x < a + 1, continued fraction 6.2.7 otherwise).
-double RegularizedGammaP(double a, double x);
+namespace driftlab::jobspec {
 
 // Regularised incomplete beta I_x(a, b), a, b > 0, 0 <= x <= 1 (A&S 26.5.1; NR 6.4: continued
 // fraction 6.4.5 by the modified Lentz method, with the symmetry I_x(a, b) = 1 - I_1-x(b, a)).
@@ -21,10 +21,6 @@ double RegularizedBeta(double a, double b, double x);
 // Standard normal CDF Phi(z) = erfc(-z / sqrt 2) / 2 (A&S 26.2.29) and its inverse.
 double NormalCdf(double z);
 double NormalQuantile(double p);
-
-// Chi-square with k degrees of freedom: P(X <= x) = P(k / 2, x / 2) (A&S 26.4.19).
-double ChiSquareCdf(double x, double k);
-double ChiSquareQuantile(double p, double k);
 
 // Student t with nu degrees of freedom: P(T <= t); 1 - P(T <= |t|) = I_{nu/(nu+t^2)}(nu/2, 1/2) / 2
 // (A&S 26.7.1 with 26.5.27; NR 6.14.10). nu may be fractional (Welch-Satterthwaite).
