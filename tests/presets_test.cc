@@ -209,14 +209,38 @@ TEST(UnitConversions, DatasheetFiguresConvertToSiByHand) {
                 "tactical accel noise");
   // 300 ppm = 3e-4.
   ExpectRelNear(FindImuPreset("tactical").accel.scale_factor_sigma, 3e-4, "tactical accel SF");
-  // 0.008 (deg/s)/sqrt(Hz) = 0.008 deg/sqrt(s) = 0.008 pi/180 rad/sqrt(s).
-  ExpectRelNear(FindImuPreset("adis16470").gyro.white_noise_density, 0.008 * kPi / 180.0,
-                "ADIS16470 rate noise density");
+  // 0.34 deg/sqrt(h) = 0.34 pi/180/60 rad/sqrt(s) (ADIS16470 Rev. C Table 1 ARW).
+  ExpectRelNear(FindImuPreset("adis16470").gyro.white_noise_density, 0.34 * kPi / 180.0 / 60.0,
+                "ADIS16470 ARW");
   // 13 ug = 13e-6 * 9.80665 m/s^2.
   ExpectRelNear(FindImuPreset("adis16470").accel.bias_flicker.bias_instability, 13e-6 * kG,
                 "ADIS16470 accel BI");
-  // VRW 0.06 m/s/sqrt(h) = 0.06 / 60 m/s/sqrt(s).
-  ExpectRelNear(FindImuPreset("stim300").accel.white_noise_density, 0.06 / 60.0, "STIM300 VRW");
+  // VRW 0.06 m/s/sqrt(h) = 0.06 / 60 m/s/sqrt(s) (revision 9); rev. 31: 0.024 m/s/sqrt(h).
+  ExpectRelNear(FindImuPreset("stim300-rev9").accel.white_noise_density, 0.06 / 60.0,
+                "STIM300 rev. 9 VRW");
+  ExpectRelNear(FindImuPreset("stim300").accel.white_noise_density, 0.024 / 60.0,
+                "STIM300 rev. 31 VRW");
+  // 0.005 mg = 5e-6 * 9.80665 m/s^2; 0.3 deg/h = 0.3 pi/180/3600 rad/s (rev. 31).
+  ExpectRelNear(FindImuPreset("stim300").accel.bias_flicker.bias_instability, 5e-6 * kG,
+                "STIM300 rev. 31 accel BI");
+  ExpectRelNear(FindImuPreset("stim300").gyro.bias_flicker.bias_instability,
+                0.3 * kPi / 180.0 / 3600.0, "STIM300 rev. 31 gyro BI");
+  // Epson M-G370PDG0: 24 uG, ARW 0.06 deg/sqrt(h), 0.01 deg misalignment, 360 deg/h initial bias.
+  ExpectRelNear(FindImuPreset("epson-m-g370pdg0").accel.bias_flicker.bias_instability, 24e-6 * kG,
+                "M-G370 accel BI");
+  ExpectRelNear(FindImuPreset("epson-m-g370pdg0").gyro.white_noise_density,
+                0.06 * kPi / 180.0 / 60.0, "M-G370 ARW");
+  ExpectRelNear(FindImuPreset("epson-m-g370pdg0").gyro.misalignment_sigma_rad, 0.01 * kPi / 180.0,
+                "M-G370 misalignment");
+  ExpectRelNear(FindImuPreset("epson-m-g370pdg0").gyro.turn_on_bias_sigma,
+                360.0 * kPi / 180.0 / 3600.0, "M-G370 initial bias");
+  // ADIS16465-1: 3.6 ug accel BI; ADIS16505-1: 26.5 um/s^2 accel BI, 0.25 deg misalignment.
+  ExpectRelNear(FindImuPreset("adis16465-1").accel.bias_flicker.bias_instability, 3.6e-6 * kG,
+                "ADIS16465-1 accel BI");
+  ExpectRelNear(FindImuPreset("adis16505-1").accel.bias_flicker.bias_instability, 26.5e-6,
+                "ADIS16505-1 accel BI");
+  ExpectRelNear(FindImuPreset("adis16505-1").gyro.misalignment_sigma_rad, 0.25 * kPi / 180.0,
+                "ADIS16505-1 misalignment");
   // 1 (deg/h)/g = pi/180/3600 / 9.80665 (rad/s)/(m/s^2), on the diagonal.
   ExpectRelNear(FindImuPreset("stim300").gyro_g_sensitivity(1, 1), kPi / 180.0 / 3600.0 / kG,
                 "STIM300 g-sensitivity");
@@ -253,11 +277,13 @@ TEST(UnitConversions, CatalogueAgreesWithTheUnitsModule) {
        dims::kVelocityRandomWalk},
       {FindImuPreset("seed002-crossbow-dmu").accel.turn_on_bias_sigma, 24.0, "mg",
        dims::kAcceleration},
-      {FindImuPreset("stim300").accel.white_noise_density, 0.06, "m/s/sqrt(h)",
+      {FindImuPreset("stim300-rev9").accel.white_noise_density, 0.06, "m/s/sqrt(h)",
        dims::kVelocityRandomWalk},
       {FindImuPreset("hg1700").accel.white_noise_density, 0.065, "ft/s/sqrt(h)",
        dims::kVelocityRandomWalk},
-      {FindImuPreset("adis16470").gyro.white_noise_density, 0.008, "(deg/s)/sqrt(Hz)",
+      {FindImuPreset("adis16470").gyro.white_noise_density, 0.34, "deg/sqrt(h)",
+       dims::kAngleRandomWalk},
+      {FindImuPreset("icm-42688-p").gyro.white_noise_density, 0.0028, "(deg/s)/sqrt(Hz)",
        dims::kAngleRandomWalk},
       {FindImuPreset("stim300").gyro.scale_factor_sigma, 500.0, "ppm", dims::kDimensionless},
       {FindImuPreset("seed002-crossbow-dmu").gyro.scale_factor_sigma, 1.5, "%",

@@ -352,23 +352,27 @@ ImuErrorModel Seed003AdxrsAdxl() {
 ImuErrorModel Adis16470() {
   return Preset(
       "adis16470",
-      "Analog Devices ADIS16470 (ADIS16470 datasheet Rev. C). Datasheet: gyro range +-2000 deg/s, "
-      "in-run bias stability 8 deg/h, rate noise density 0.008 (deg/s)/sqrt(Hz); accel range "
-      "+-40 g, in-run bias stability 13 ug. Assumed: accel noise density 230 ug/sqrt(Hz) (not in "
-      "the retrieved datasheet text; typical of ADI's +-40 g MEMS IMUs - verify before relying on "
-      "it); turn-on bias 0.1 deg/s and 2 mg, scale factor 0.3 %, misalignment 1 mrad (factory-"
-      "calibrated MEMS IMU class); flicker over tau 1-1000 s; no random walk.",
-      Triad{.white_noise_density = DegPerSPerSqrtHz(0.008),
+      "Analog Devices ADIS16470 (ADIS16470 datasheet Rev. C). Feature list (read in the Rev. C "
+      "text): gyro range +-2000 deg/s, in-run bias stability 8 deg/h, rate noise density 0.008 "
+      "(deg/s)/sqrt(Hz); accel range +-40 g, in-run bias stability 13 ug. Table 1 (as quoted in "
+      "driftlab issue 19 from Rev. C; the table itself was not retrievable here): gyro ARW 0.34 "
+      "deg/sqrt(h), accel VRW 0.037 m/s/sqrt(h) (noise density 100 ug/sqrt(Hz) at 10-40 Hz), "
+      "misalignment +-0.1 deg axis to axis (taken as 1 sigma). White noise is the Allan figure "
+      "(ARW, VRW), which is what the model's white noise reproduces at tau = 1 s; the band-limited "
+      "densities are 1.4x (gyro) and 1.6x (accel) larger. Assumed: turn-on bias 0.1 deg/s and 2 "
+      "mg, scale factor 0.3 % (factory-calibrated MEMS IMU class; not in the retrieved text); "
+      "flicker over tau 1-1000 s; no random walk.",
+      Triad{.white_noise_density = DegPerSqrtH(0.34),
             .bias_instability = DegPerH(8.0),
             .turn_on_bias_sigma = DegPerS(0.1),
             .scale_factor_sigma = Percent(0.3),
-            .misalignment_sigma_rad = Mrad(1.0),
+            .misalignment_sigma_rad = Deg(0.1),
             .range = DegPerS(2000.0)},
-      Triad{.white_noise_density = MicroGPerSqrtHz(230.0),
+      Triad{.white_noise_density = MPerSPerSqrtH(0.037),
             .bias_instability = MicroG(13.0),
             .turn_on_bias_sigma = MilliG(2.0),
             .scale_factor_sigma = Percent(0.3),
-            .misalignment_sigma_rad = Mrad(1.0),
+            .misalignment_sigma_rad = Deg(0.1),
             .range = Gee(40.0)});
 }
 
@@ -416,6 +420,55 @@ ImuErrorModel Adis16467() {
             .scale_factor_sigma = Percent(0.3),
             .misalignment_sigma_rad = Deg(0.05),
             .range = Gee(40.0)});
+}
+
+ImuErrorModel Adis16465() {
+  return Preset(
+      "adis16465-1",
+      "Analog Devices ADIS16465-1 (ADIS16465 datasheet, values read in its feature list). "
+      "Datasheet: gyro range +-125 deg/s (-1 model), in-run bias stability 2 deg/h, ARW 0.15 "
+      "deg/sqrt(h), axis-to-axis misalignment +-0.05 deg (taken as 1 sigma); accel range +-8 g, "
+      "in-run bias stability 3.6 ug. Assumed: accel VRW 0.012 m/s/sqrt(h) (not in the feature "
+      "list; as adis16495-1, the same +-8 g accelerometer class); turn-on bias 0.05 deg/s and "
+      "0.3 mg, scale factor 0.1 % (factory-calibrated tactical MEMS class); accel misalignment = "
+      "gyro's; flicker over tau 1-1000 s; no random walk.",
+      Triad{.white_noise_density = DegPerSqrtH(0.15),
+            .bias_instability = DegPerH(2.0),
+            .turn_on_bias_sigma = DegPerS(0.05),
+            .scale_factor_sigma = Percent(0.1),
+            .misalignment_sigma_rad = Deg(0.05),
+            .range = DegPerS(125.0)},
+      Triad{.white_noise_density = MPerSPerSqrtH(0.012),
+            .bias_instability = MicroG(3.6),
+            .turn_on_bias_sigma = MilliG(0.3),
+            .scale_factor_sigma = Percent(0.1),
+            .misalignment_sigma_rad = Deg(0.05),
+            .range = Gee(8.0)});
+}
+
+ImuErrorModel Adis16505() {
+  return Preset(
+      "adis16505-1",
+      "Analog Devices ADIS16505-1 (ADIS16505 datasheet, values as quoted from its feature list "
+      "in driftlab issue 19; the datasheet itself was not retrievable here). Datasheet: gyro range "
+      "+-125 deg/s (-1 "
+      "model), ARW 0.13 deg/sqrt(h), in-run bias stability 2.3 deg/h; accel in-run bias "
+      "stability 26.5 um/s^2 (2.7 ug); misalignment 0.25 deg axis to axis (taken as 1 sigma). "
+      "Assumed: accel range +-8 g and VRW 0.012 m/s/sqrt(h) (as adis16465-1, not in the quoted "
+      "list); turn-on bias 0.05 deg/s and 0.3 mg, scale factor 0.1 %; accel misalignment = "
+      "gyro's; flicker over tau 1-1000 s; no random walk.",
+      Triad{.white_noise_density = DegPerSqrtH(0.13),
+            .bias_instability = DegPerH(2.3),
+            .turn_on_bias_sigma = DegPerS(0.05),
+            .scale_factor_sigma = Percent(0.1),
+            .misalignment_sigma_rad = Deg(0.25),
+            .range = DegPerS(125.0)},
+      Triad{.white_noise_density = MPerSPerSqrtH(0.012),
+            .bias_instability = 26.5e-6,  // 26.5 um/s^2, the datasheet's own SI figure
+            .turn_on_bias_sigma = MilliG(0.3),
+            .scale_factor_sigma = Percent(0.1),
+            .misalignment_sigma_rad = Deg(0.25),
+            .range = Gee(8.0)});
 }
 
 ImuErrorModel Icm42688p() {
@@ -466,9 +519,9 @@ ImuErrorModel MtI300() {
       DegPerSPerG(0.003));
 }
 
-ImuErrorModel Stim300() {
+ImuErrorModel Stim300Rev9() {
   return Preset(
-      "stim300",
+      "stim300-rev9",
       "Safran Sensonor STIM300, 10 g accelerometer option (STIM300 datasheet revision 9, values "
       "as quoted by the NavToolkit stim300_model documentation, which links that revision; the "
       "datasheet itself was not retrieved). Gyro: bias instability 0.5 deg/h (Sensonor FAQ: "
@@ -492,6 +545,67 @@ ImuErrorModel Stim300() {
             .misalignment_sigma_rad = Mrad(1.0),
             .range = Gee(10.0)},
       DegPerHPerG(1.0));
+}
+
+// STIM300 datasheet TS1524 rev. 31 (figures as quoted in driftlab issue 19 from its tables 5-3 and
+// 5-5; the revision itself was not retrievable here, revision 9's figures above come through
+// NavToolkit). Bias instability is the minimum of the Allan curve (Sensonor FAQ: "lowest point of
+// curve", 20 h test at 1000 Hz); the sheet also gives the Allan deviation at 600 s (0.5 deg/h gyro,
+// 0.006 mg accel), which this model does not fit separately: with ARW 0.15 deg/sqrt(h) the white
+// noise alone gives N / sqrt(tau) = 0.15 deg/sqrt(h) / sqrt(1/6 h) = 0.37 deg/h at 600 s, and the
+// flicker floor 0.664 B = 0.20 deg/h, together 0.42 deg/h.
+ImuErrorModel Stim300() {
+  return Preset(
+      "stim300",
+      "Safran Sensonor STIM300, 10 g accelerometer option (STIM300 datasheet TS1524 rev. 31, "
+      "values as quoted from its tables 5-3 and 5-5 in driftlab issue 19; that revision was not "
+      "retrievable here). Gyro: bias instability 0.3 deg/h (minimum of the Allan curve; 0.5 deg/h "
+      "at 600 s not modelled separately), ARW 0.15 deg/sqrt(h), scale-factor accuracy +-500 ppm, "
+      "range 400 deg/s. Accel: bias instability 0.005 mg (0.006 mg at 600 s), VRW 0.024 "
+      "m/s/sqrt(h), scale-factor accuracy +-200 ppm, range 10 g. From revision 9 (as stim300-rev9, "
+      "not in the rev. 31 figures quoted): gyro turn-on repeatability 4 deg/h, g-sensitivity 1 "
+      "(deg/h)/g with g-compensation, accel bias on/off repeatability 0.75 mg, misalignment 1 "
+      "mrad. "
+      "Assumed: +-bounds taken as 1 sigma; g-sensitivity on the diagonal; flicker over tau "
+      "1-1000 s; no random walk.",
+      Triad{.white_noise_density = DegPerSqrtH(0.15),
+            .bias_instability = DegPerH(0.3),
+            .turn_on_bias_sigma = DegPerH(4.0),
+            .scale_factor_sigma = Ppm(500.0),
+            .misalignment_sigma_rad = Mrad(1.0),
+            .range = DegPerS(400.0)},
+      Triad{.white_noise_density = MPerSPerSqrtH(0.024),
+            .bias_instability = MilliG(0.005),
+            .turn_on_bias_sigma = MilliG(0.75),
+            .scale_factor_sigma = Ppm(200.0),
+            .misalignment_sigma_rad = Mrad(1.0),
+            .range = Gee(10.0)},
+      DegPerHPerG(1.0));
+}
+
+// Epson M-G370PDG0 (figures as quoted in driftlab issue 19 from the full data sheet E Rev. 1.1,
+// Table 1.3; the document was not retrievable here).
+ImuErrorModel EpsonMG370() {
+  return Preset(
+      "epson-m-g370pdg0",
+      "Epson M-G370PDG0 (M-G370PDG0 datasheet E Rev. 1.1, values as quoted from its Table 1.3 "
+      "in driftlab issue 19; the document was not retrievable here). Gyro: range +-450 deg/s, bias "
+      "instability 0.8 deg/h, ARW 0.06 deg/sqrt(h), initial bias 360 deg/h (1 sigma), scale factor "
+      "+-0.2 %; accel: range +-16 G (largest selected), bias instability 24 uG, VRW 0.02 "
+      "m/s/sqrt(h), initial bias 2 mG (1 sigma), scale factor +-0.1 %; misalignment 0.01 deg (1 "
+      "sigma). Assumed: +-bounds taken as 1 sigma; flicker over tau 1-1000 s; no random walk.",
+      Triad{.white_noise_density = DegPerSqrtH(0.06),
+            .bias_instability = DegPerH(0.8),
+            .turn_on_bias_sigma = DegPerH(360.0),
+            .scale_factor_sigma = Percent(0.2),
+            .misalignment_sigma_rad = Deg(0.01),
+            .range = DegPerS(450.0)},
+      Triad{.white_noise_density = MPerSPerSqrtH(0.02),
+            .bias_instability = MicroG(24.0),
+            .turn_on_bias_sigma = MilliG(2.0),
+            .scale_factor_sigma = Percent(0.1),
+            .misalignment_sigma_rad = Deg(0.01),
+            .range = Gee(16.0)});
 }
 
 ImuErrorModel Hg1700() {
@@ -538,7 +652,7 @@ ImuErrorModel Hg9900() {
 
 // Bosch BMI088: the datasheet PDF itself was not retrievable; the description says which figures
 // were read from a retrieved source quoting the datasheet ("quoted") and which are assumptions of
-// the model class ("assumed"). (Epson M-G370, Honeywell HG4930 and Xsens MTi-630 were left out:
+// the model class ("assumed"). (Honeywell HG4930 and Xsens MTi-630 were left out:
 // no retrievable source gave their figures, and a catalogue entry must cite one.)
 
 ImuErrorModel Bmi088() {
@@ -628,9 +742,13 @@ std::vector<ImuErrorModel> BuildCatalogue() {
           Adis16470(),
           Adis16495(),
           Adis16467(),
+          Adis16465(),
+          Adis16505(),
           Icm42688p(),
           MtI300(),
           Stim300(),
+          Stim300Rev9(),
+          EpsonMG370(),
           Hg1700(),
           Hg9900(),
           Bmi088(),

@@ -49,7 +49,7 @@ TEST(DatasheetTest, TacticalDatasheetGivesThePresetNumbers) {
 
 TEST(DatasheetTest, Stim300FlowMappingDatasheetGivesThePresetNumbersWithGSensitivity) {
   const DatasheetModel d = LoadDatasheet(kData + "datasheet_stim300.yaml");
-  const ImuErrorModel& preset = FindImuPreset("stim300");
+  const ImuErrorModel& preset = FindImuPreset("stim300-rev9");
   ExpectTriad(d.model.gyro, preset.gyro, "gyro");
   ExpectTriad(d.model.accel, preset.accel, "accel");
   for (int i = 0; i < 9; ++i) {

@@ -9,32 +9,35 @@
 // Asserted per preset, triad and seed:
 //  * every term the preset has (white noise N, bias instability B) is kept by the selection test
 //    (noise_fit.h) and the preset value lies inside the fit's 99.9 % interval (z = 3.29 on the
-//    variance coefficient, as the 95 % interval is built);
+//    variance coefficient, as the 95 % interval is built) -- except a B whose flicker floor no
+//    record can show (Case::floor_visible): kept and inside, or "not determined" with a 95 % upper
+//    bound that covers the preset value (at most the binomial 99.9 % quantile of seeds may not);
 //  * no term the preset lacks (quantization, random walk, rate ramp) is reported present.
 // Asserted over all seeds: the number of preset values outside their 95 % interval is at most
 // the binomial(n, 0.05) 99.9 % quantile (n = 2 terms x 2 triads x seeds x presets).
 // Run time: the simulation dominates (7.2e5 steps per record); under DRIFTLAB_SANITIZE 3 seeds.
 //
-// Measured (RelWithDebInfo, default
-// confidence 0.999, generalised least squares; 41 s CPU on one core for the 30 records; run with
-// --gtest_also_run_disabled_tests --gtest_filter='*StaticRecord*'):
+// Measured with the catalogue figures of issue 19 (stim300 = TS1524 rev. 31, adis16470 = Rev. C
+// Table 1 ARW/VRW; default confidence 0.999, generalised least squares; 54 s on one core for the
+// 30 records; --gtest_filter='*StaticRecord*'):
 //   preset / triad     N/preset mean  B/preset mean (range)   B not kept  spurious term kept
-//   stim300 gyro       1.0002         0.726 (0.000-1.242)     3 of 10     1 (K, D 24.3)
-//   stim300 accel      1.0001         0.994 (0.955-1.015)     0           0 (max D 7.75)
-//   adis16470 gyro     1.0002         0.988 (0.922-1.031)     0           0 (max D 4.26)
-//   adis16470 accel    1.0000         0.863 (0.000-1.286)     2 of 10     1 (K, D 12.7)
+//   stim300 gyro       1.0002         -- (floor invisible)    9 of 10     0 (max D 8.37)
+//                      (bound / preset 1.27-1.77, below the preset in 0 of 9; kept once, 1.44)
+//   stim300 accel      1.0000         0.991 (0.844-1.092)     0           0 (max D 8.69)
+//   adis16470 gyro     1.0002         0.992 (0.949-1.026)     0           0 (max D 4.68)
+//   adis16470 accel    1.0000         0.985 (0.883-1.026)     0           0 (max D 8.22)
 //   tactical gyro      1.0002         0.990 (0.936-1.030)     0           0 (max D 4.52)
 //   tactical accel     1.0007         0.999 (0.996-1.003)     0           0 (max D 8.02)
-//   preset values outside their 95 % interval: 10 of 120 (expected 6, binomial 99.9 % bound 14);
-//   every kept B and every N inside its 99.9 % interval.
-// PresetTermsRecoveredAndNoAbsentTermReported runs the four triads that pass (stim300 accel,
-// adis16470 gyro, tactical gyro and accel); DISABLED_LateFloorTriadsBiasInstabilityRecovered
-// keeps the two that do not. What fails there: where the white noise meets the flicker floor only
-// at ~700 s (stim300 gyro, adis16470 accel: floor 0.664 B reached at tau ~ (N / 0.664 B)^2), a
-// 2-hour record shows the floor in its last 2-3 octaves (edf 2-15), where the band-limited flicker
-// (1-1000 s) bends down and a random walk K fits that realisation as well or better; B is then
-// dropped (with its upper bound) or replaced by K. The whitening uses the white-FM correlation, a
-// lower bound where flicker dominates, so D there is still somewhat overstated.
+//   preset values outside their 95 % interval: 6 of 120 (expected 6, binomial 99.9 % bound 14).
+// The adis16470 accelerometer passes since its white noise is the datasheet's VRW 0.037
+// m/s/sqrt(h) (the earlier assumed 230 ug/sqrt(Hz) = 0.135 m/s/sqrt(h) hid the floor until ~700 s).
+// DISABLED_LateFloorTriadsBiasInstabilityRecovered keeps the known limit: the revision-9 STIM300
+// gyro (B 0.5 deg/h) meets its floor only at ~700 s (floor 0.664 B reached at
+// tau ~ (N / 0.664 B)^2), so a 2-hour record shows the floor in its last 2-3 octaves (edf 2-15),
+// where the band-limited flicker (1-1000 s) bends down and a random walk K fits that realisation
+// as well or better; B is then dropped (with its upper bound) or replaced by K (measured: B/preset
+// 0.726, range 0.000-1.242; K kept with D 24.3 in one seed). The whitening uses the white-FM
+// correlation, a lower bound where flicker dominates, so D there is still somewhat overstated.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -104,6 +107,11 @@ struct Case {
   const char* preset;
   bool gyro;
   bool accel;
+  // false: the preset's flicker floor 0.664 B lies below the white noise N / sqrt(tau) at every
+  // tau of its band (tau_max 1000 s), so no record length shows its signature; B must then be
+  // either kept (and inside its interval) or reported "not determined" with a 95 % upper bound
+  // that covers the preset value (at most the binomial(seeds, 0.05) 99.9 % quantile may not).
+  bool floor_visible = true;
 };
 
 void CheckPresets(const std::vector<Case>& cases) {
@@ -115,7 +123,8 @@ void CheckPresets(const std::vector<Case>& cases) {
     struct Summary {
       double n_sum = 0, b_sum = 0, b_min = INFINITY, b_max = 0, d_b_min = INFINITY;
       double d_absent_max = 0;
-      int n_out = 0, b_out = 0, warned = 0;
+      double b_bound_min = INFINITY, b_bound_max = 0;  // upper bound / preset, B not determined
+      int n_out = 0, b_out = 0, warned = 0, b_undetermined = 0, bound_below_truth = 0;
     };
     std::array<Summary, 2> summary;  // gyro, accel
     for (int s = 0; s < kSeeds; ++s) {
@@ -135,16 +144,27 @@ void CheckPresets(const std::vector<Case>& cases) {
         const std::string where = std::string(name) + (gyro ? " gyro" : " accel") + " seed " +
                                   std::to_string(kSeedList[s]);
         EXPECT_TRUE(fit.white_noise.determined) << where;
-        EXPECT_TRUE(fit.bias_instability.determined)
-            << where << ": D " << fit.bias_instability.lr_statistic << " < "
-            << fit.bias_instability.lr_threshold;
+        const double b_true = truth.bias_flicker.bias_instability;
+        if (c.floor_visible) {
+          EXPECT_TRUE(fit.bias_instability.determined)
+              << where << ": D " << fit.bias_instability.lr_statistic << " < "
+              << fit.bias_instability.lr_threshold;
+        }
         // 99.9 %: 3.29 sigma (two-sided normal quantile).
         EXPECT_TRUE(Inside(fit.white_noise, truth.white_noise_density, 3.29))
             << where << ": N " << fit.white_noise.value << " +- " << fit.white_noise.sigma
             << ", preset " << truth.white_noise_density;
-        EXPECT_TRUE(Inside(fit.bias_instability, truth.bias_flicker.bias_instability, 3.29))
-            << where << ": B " << fit.bias_instability.value << " +- " << fit.bias_instability.sigma
-            << ", preset " << truth.bias_flicker.bias_instability;
+        if (fit.bias_instability.determined) {
+          EXPECT_TRUE(Inside(fit.bias_instability, b_true, 3.29))
+              << where << ": B " << fit.bias_instability.value << " +- "
+              << fit.bias_instability.sigma << ", preset " << b_true;
+        } else if (!c.floor_visible) {
+          EXPECT_TRUE(std::isfinite(fit.bias_instability.upper_bound)) << where;
+          sum.bound_below_truth += fit.bias_instability.upper_bound < b_true ? 1 : 0;
+          sum.b_bound_max = std::max(sum.b_bound_max, fit.bias_instability.upper_bound / b_true);
+          sum.b_bound_min = std::min(sum.b_bound_min, fit.bias_instability.upper_bound / b_true);
+          ++sum.b_undetermined;
+        }
         for (const NoiseTermEstimate* absent :
              {&fit.quantization, &fit.random_walk, &fit.rate_ramp}) {
           EXPECT_FALSE(absent->determined)
@@ -154,7 +174,10 @@ void CheckPresets(const std::vector<Case>& cases) {
           }
         }
         const bool n_in = Inside(fit.white_noise, truth.white_noise_density, 1.96);
-        const bool b_in = Inside(fit.bias_instability, truth.bias_flicker.bias_instability, 1.96);
+        // Not determined: "inside" when the 95 % upper bound covers the preset value.
+        const bool b_in = fit.bias_instability.determined
+                              ? Inside(fit.bias_instability, b_true, 1.96)
+                              : fit.bias_instability.upper_bound >= b_true;
         sum.n_out += n_in ? 0 : 1;
         sum.b_out += b_in ? 0 : 1;
         checks += 2;
@@ -177,6 +200,14 @@ void CheckPresets(const std::vector<Case>& cases) {
           "warning %d\n",
           name, gyro ? "gyro " : "accel", kSeeds, sum.n_sum / kSeeds, sum.n_out, sum.b_sum / kSeeds,
           sum.b_min, sum.b_max, sum.b_out, sum.d_b_min, sum.d_absent_max, sum.warned);
+      if (sum.b_undetermined > 0) {
+        std::printf(
+            "%-9s %s: B not determined in %d seeds, 95 %% upper bound / preset %.2f-%.2f, below "
+            "the preset in %d\n",
+            name, gyro ? "gyro " : "accel", sum.b_undetermined, sum.b_bound_min, sum.b_bound_max,
+            sum.bound_below_truth);
+      }
+      EXPECT_LE(sum.bound_below_truth, BinomialQuantile(kSeeds, 0.05, 0.999)) << name;
     }
   }
   const int allowed = BinomialQuantile(checks, 0.05, 0.999);
@@ -188,14 +219,19 @@ void CheckPresets(const std::vector<Case>& cases) {
   EXPECT_LE(outside_95, allowed);
 }
 
-// The triads that meet the assertions at 2 hours (white noise meets the flicker floor by ~100 s).
+// Every triad of the three presets. The STIM300 gyro (TS1524 rev. 31: N 0.15 deg/sqrt(h),
+// B 0.3 deg/h) has its floor 0.664 B = 0.20 deg/h below its white noise at every tau of the
+// simulated band (N / sqrt(1000 s) = 0.28 deg/h at tau_max), so its B is checked as an upper bound.
 TEST(NoiseFitStaticRecordSlowTest, PresetTermsRecoveredAndNoAbsentTermReported) {
-  CheckPresets({{"stim300", false, true}, {"adis16470", true, false}, {"tactical", true, true}});
+  CheckPresets(
+      {{"stim300", true, true, false}, {"adis16470", true, true}, {"tactical", true, true}});
 }
 
-// The two triads whose floor shows only in the record's last octaves (see the header comment).
+// The revision-9 STIM300 gyro (N 0.15 deg/sqrt(h), B 0.5 deg/h) meets its floor only at ~700 s:
+// a 2-hour record shows it in its last 2-3 octaves (see the header comment), and B is dropped
+// or replaced by a random walk in 3 of 10 seeds; kept disabled as the known limit.
 TEST(NoiseFitStaticRecordSlowTest, DISABLED_LateFloorTriadsBiasInstabilityRecovered) {
-  CheckPresets({{"stim300", true, false}, {"adis16470", false, true}});
+  CheckPresets({{"stim300-rev9", true, false}});
 }
 
 }  // namespace

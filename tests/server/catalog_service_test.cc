@@ -48,13 +48,18 @@ TEST_F(CatalogServiceTest, ListPresetsGivesEveryCatalogueModelWithGradeAndSource
   EXPECT_EQ(find("tactical").source(), "seed 001 grade tables");
   EXPECT_EQ(find("seed002-epson").source(), "seed 002 catalogue");
   EXPECT_EQ(find("adis16470").source(), "ADIS16470 datasheet Rev. C");
-  EXPECT_EQ(find("stim300").source(), "STIM300 datasheet revision 9");
+  EXPECT_EQ(find("stim300").source(), "STIM300 datasheet TS1524 rev. 31");
+  EXPECT_EQ(find("stim300-rev9").source(), "STIM300 datasheet revision 9");
+  EXPECT_EQ(find("epson-m-g370pdg0").source(), "M-G370PDG0 datasheet E Rev. 1.1");
+  EXPECT_EQ(find("adis16465-1").source(), "ADIS16465 datasheet");
+  EXPECT_EQ(find("adis16505-1").source(), "ADIS16505 datasheet");
   EXPECT_EQ(find("hg1700").source(), "HG1700 brochure N61-1619-000-001");
   EXPECT_EQ(find("seed003-adxrs300-adxl330").source(),
             "seed 003; ADXRS300 datasheet Rev. B; ADXL330 datasheet Rev. A");
   // Seed 001 gyro grades (ARW and bias instability must both meet it): STIM300 0.15 deg/sqrt(h)
-  // and 0.5 deg/h: tactical; ADIS16470 0.008 (deg/s)/sqrt(Hz) = 0.48 deg/sqrt(h) and 8 deg/h:
-  // tactical; BMI088 0.014 (deg/s)/sqrt(Hz) = 0.84 deg/sqrt(h) > 0.5: rate grade.
+  // and 0.3 deg/h: tactical (0.3 is in the table's 0.01-1 gap, counted tactical); ADIS16470
+  // 0.34 deg/sqrt(h) and 8 deg/h: tactical; BMI088 0.014 (deg/s)/sqrt(Hz) = 0.84 deg/sqrt(h) > 0.5:
+  // rate grade.
   EXPECT_EQ(find("stim300").grade(), "tactical");
   EXPECT_EQ(find("adis16470").grade(), "tactical");
   EXPECT_EQ(find("bmi088").grade(), "rate");
