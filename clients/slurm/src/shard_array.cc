@@ -22,12 +22,19 @@ namespace driftlab::slurm {
 
 namespace fs = std::filesystem;
 
-CommandOutput RunCommand(const std::vector<std::string>& args) {
+CommandOutput RunCommand(const std::vector<std::string>& args, const std::string& input) {
   CommandOutput result;
   int pipe_fds[2];
+  int input_fds[2];
   if (pipe2(pipe_fds, O_CLOEXEC) != 0) return result;
+  if (pipe2(input_fds, O_CLOEXEC) != 0) {
+    close(pipe_fds[0]);
+    close(pipe_fds[1]);
+    return result;
+  }
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, input_fds[0], STDIN_FILENO);
   posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDOUT_FILENO);
   posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDERR_FILENO);
   std::vector<std::string> copy = args;
@@ -38,6 +45,17 @@ CommandOutput RunCommand(const std::vector<std::string>& args) {
   const int spawned = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   close(pipe_fds[1]);
+  close(input_fds[0]);
+  if (spawned == 0 && !input.empty()) {
+    // Small inputs only (a manifest): they fit the pipe buffer, so this cannot block on a child
+    // that writes before it reads.
+    ssize_t written = 0;
+    for (size_t at = 0; at < input.size(); at += static_cast<size_t>(written)) {
+      written = write(input_fds[1], input.data() + at, input.size() - at);
+      if (written <= 0) break;
+    }
+  }
+  close(input_fds[1]);
   if (spawned != 0) {
     close(pipe_fds[0]);
     result.text = fmt::format("cannot start {}: {}", args[0], std::strerror(spawned));
@@ -223,14 +241,19 @@ int ShardArray::TasksInQueue() {
   return count;
 }
 
-v1::JobResult ShardArray::Merge(const std::string& engine_version) const {
-  std::vector<v1::JobResult> shards;
+v1::JobResult MergeShardResults(const fs::path& work_dir, uint32_t shards,
+                                const std::string& engine_version) {
+  std::vector<v1::JobResult> results;
   std::vector<std::string> names;
-  for (uint32_t i = 0; i < options_.shards; ++i) {
-    names.push_back(ShardPath(i).string());
-    shards.push_back(jobspec::ReadJobResult(names.back()));
+  for (uint32_t i = 0; i < shards; ++i) {
+    names.push_back((work_dir / fmt::format("shard-{}.json", i)).string());
+    results.push_back(jobspec::ReadJobResult(names.back()));
   }
-  return jobspec::MergeJobResults(shards, names, engine_version);
+  return jobspec::MergeJobResults(results, names, engine_version);
+}
+
+v1::JobResult ShardArray::Merge(const std::string& engine_version) const {
+  return MergeShardResults(options_.work_dir, options_.shards, engine_version);
 }
 
 }  // namespace driftlab::slurm

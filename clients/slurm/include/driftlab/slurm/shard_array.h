@@ -31,14 +31,21 @@ struct CommandOutput {
   std::string text;  // stdout and stderr together (at most 1 MiB kept)
 };
 
-// Runs args[0] (searched on PATH) with the arguments, without a shell.
-CommandOutput RunCommand(const std::vector<std::string>& args);
+// Runs args[0] (searched on PATH) with the arguments, without a shell; `input` is its stdin
+// (at most 64 KiB: written before the output is read).
+CommandOutput RunCommand(const std::vector<std::string>& args, const std::string& input = "");
 
 // 'text' for sh, with ' written as '\''.
 std::string ShellQuote(const std::string& text);
 
 // The last non-empty line of a file (escaped and bounded as MessageText), "(no log)" without it.
 std::string LastLine(const std::filesystem::path& path);
+
+// Reads DIR/shard-0.json .. DIR/shard-(K-1).json and merges them (exact sums: equal to an
+// in-process run of the job, timings aside). Throws SpecError naming a missing or bad shard.
+// Also used by driftlab-server's Kubernetes backend, whose pods write the same files.
+v1::JobResult MergeShardResults(const std::filesystem::path& work_dir, uint32_t shards,
+                                const std::string& engine_version);
 
 struct ShardArrayOptions {
   std::filesystem::path work_dir;  // absolute; shard-i.json, shard-i.log, driftlab-shard.sh
