@@ -102,8 +102,7 @@ uint32_t ClusterShardCount(const ClusterOptions& options, uint32_t runs) {
   return std::max(1u, std::min(options.shards, runs));
 }
 
-std::unique_ptr<ClusterRun> MakeClusterRun(const ClusterOptions& options,
-                                           const std::string& job_id,
+std::unique_ptr<ClusterRun> MakeClusterRun(const ClusterOptions& options, const std::string& job_id,
                                            const v1::SubmitJobRequest& request, uint32_t runs) {
   const uint32_t shards = ClusterShardCount(options, runs);
   if (options.kind == ClusterKind::kKubernetes) {

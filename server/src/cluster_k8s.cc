@@ -102,8 +102,8 @@ class KubernetesRun : public ClusterRun {
     }
     const slurm::CommandOutput r = slurm::RunCommand({"kubectl", "create", "-f", "-"}, manifest);
     if (r.status != 0) {
-      throw ClusterError(fmt::format("kubectl create failed (status {}): {}", r.status,
-                                     MessageText(r.text, 500)));
+      throw ClusterError(
+          fmt::format("kubectl create failed (status {}): {}", r.status, MessageText(r.text, 500)));
     }
   }
 
@@ -122,8 +122,8 @@ class KubernetesRun : public ClusterRun {
       if (r.text.find("NotFound") != std::string::npos) {
         throw ClusterError(fmt::format("the Kubernetes Job {} no longer exists", name_));
       }
-      *warning = fmt::format("kubectl get job failed (status {}): {}", r.status,
-                             MessageText(r.text, 300));
+      *warning =
+          fmt::format("kubectl get job failed (status {}): {}", r.status, MessageText(r.text, 300));
       return std::nullopt;
     }
     const KubernetesJobStatus status = ParseKubernetesJob(r.text, shards_);
@@ -166,9 +166,10 @@ std::set<uint32_t> ParseIndexList(const std::string& text, uint32_t completions,
   std::set<uint32_t> out;
   if (text.empty()) return out;
   const auto bad = [&] {
-    return ClusterError(fmt::format("{}: \"{}\" is not an index list like \"1,3-5,7\" of indexes "
-                                    "0 to {}",
-                                    field, MessageText(text, 200), completions - 1));
+    return ClusterError(
+        fmt::format("{}: \"{}\" is not an index list like \"1,3-5,7\" of indexes "
+                    "0 to {}",
+                    field, MessageText(text, 200), completions - 1));
   };
   std::istringstream items(text);
   std::string item;
@@ -206,7 +207,8 @@ KubernetesJobStatus ParseKubernetesJob(const std::string& json, uint32_t complet
   KubernetesJobStatus out;
   const Value* status_value = Field(job, "status");
   if (status_value == nullptr) return out;  // not yet observed by the Job controller
-  if (status_value->kind_case() != Value::kStructValue) throw ClusterError("Job .status: not an object");
+  if (status_value->kind_case() != Value::kStructValue)
+    throw ClusterError("Job .status: not an object");
   const Struct& status = status_value->struct_value();
   out.active = Count(status, "active");
   out.succeeded = Count(status, "succeeded");
@@ -225,8 +227,8 @@ KubernetesJobStatus ParseKubernetesJob(const std::string& json, uint32_t complet
       if (type == "Complete" || type == "SuccessCriteriaMet") out.complete = true;
       if (type == "Failed" || type == "FailureTarget") {
         out.failed_job = true;
-        out.failure = MessageText(
-            Text(condition, "reason") + ": " + Text(condition, "message"), 300);
+        out.failure =
+            MessageText(Text(condition, "reason") + ": " + Text(condition, "message"), 300);
       }
     }
   }
@@ -295,9 +297,7 @@ std::string RenderKubernetesJob(const std::string& template_text,
 std::vector<std::string> KubernetesShardArgs(const std::string& job_file, uint32_t shards,
                                              const std::string& work_dir,
                                              const std::vector<std::string>& extra) {
-  std::vector<std::string> args = {"run",
-                                   job_file,
-                                   "--quiet",
+  std::vector<std::string> args = {"run", job_file, "--quiet",
                                    fmt::format("--shard=$(JOB_COMPLETION_INDEX)/{}", shards),
                                    "--out=" + work_dir + "/shard-$(JOB_COMPLETION_INDEX).json"};
   args.insert(args.end(), extra.begin(), extra.end());

@@ -594,9 +594,10 @@ void JobManager::WorkerLoop() {
 bool JobManager::UsesCluster(const StoredJob& row) const {
   if (cluster_.kind == ClusterKind::kNone) {
     if (!row.cluster.empty()) {
-      spdlog::warn("job={} was handed to a cluster ({}) but this server has no --cluster: it runs "
-                   "in-process",
-                   row.id, row.cluster);
+      spdlog::warn(
+          "job={} was handed to a cluster ({}) but this server has no --cluster: it runs "
+          "in-process",
+          row.id, row.cluster);
     }
     return false;
   }
@@ -642,9 +643,10 @@ void JobManager::RunClusterJob(const std::shared_ptr<LiveJob>& live) {
                    live->row.owner, runs, attempts, run->Handle(), k);
     } else {
       run->Attach(live->row.cluster);
-      spdlog::info("job={} owner={} state=RUNNING runs={} attempt={} cluster=\"{}\" shards={} "
-                   "(re-attached)",
-                   id, live->row.owner, runs, attempts, run->Handle(), k);
+      spdlog::info(
+          "job={} owner={} state=RUNNING runs={} attempt={} cluster=\"{}\" shards={} "
+          "(re-attached)",
+          id, live->row.owner, runs, attempts, run->Handle(), k);
     }
     std::string handle = run->Handle();
     store_->SetCluster(id, handle);
@@ -723,9 +725,10 @@ void JobManager::RunClusterJob(const std::shared_ptr<LiveJob>& live) {
   live_.erase(id);
   changed_.notify_all();
   if (requeue) {
-    spdlog::info("job={} owner={} state=QUEUED runs={} seconds={:.3f} (shutdown; its shards keep "
-                 "running)",
-                 id, live->row.owner, runs, seconds);
+    spdlog::info(
+        "job={} owner={} state=QUEUED runs={} seconds={:.3f} (shutdown; its shards keep "
+        "running)",
+        id, live->row.owner, runs, seconds);
   } else if (final_state == v1::SUCCEEDED) {
     spdlog::info("job={} owner={} state=SUCCEEDED runs={} seconds={:.3f}", id, live->row.owner,
                  runs, seconds);

@@ -23,9 +23,9 @@
 #include <optional>
 #include <string>
 
+#include "driftlab/output_files.h"
 #include "driftlab/server/auth.h"
 #include "driftlab/server/server.h"
-#include "driftlab/output_files.h"
 #include "driftlab/spec_error.h"
 
 namespace {
@@ -135,9 +135,10 @@ int main(int argc, char** argv) {
 
   if (cluster_kind != "none") {
     if (cluster_dir.empty()) {
-      fmt::print(stderr, "error: --cluster {} needs --cluster-dir DIR (a directory the {} can "
-                 "read and write at the same path)\n", cluster_kind,
-                 cluster_kind == "slurm" ? "compute nodes" : "shard pods");
+      fmt::print(stderr,
+                 "error: --cluster {} needs --cluster-dir DIR (a directory the {} can "
+                 "read and write at the same path)\n",
+                 cluster_kind, cluster_kind == "slurm" ? "compute nodes" : "shard pods");
       return 2;
     }
     namespace fs = std::filesystem;
@@ -147,19 +148,23 @@ int main(int argc, char** argv) {
     options.cluster.driftlab_binary =
         cluster_driftlab.empty() ? fs::read_symlink("/proc/self/exe").parent_path() / "driftlab"
                                  : fs::absolute(cluster_driftlab);
-    options.cluster.k8s_template =
-        k8s_template.empty() ? fs::path("/usr/share/driftlab/k8s/server-shard-job.yaml")
-                             : fs::path(k8s_template);
+    options.cluster.k8s_template = k8s_template.empty()
+                                       ? fs::path("/usr/share/driftlab/k8s/server-shard-job.yaml")
+                                       : fs::path(k8s_template);
     if (options.cluster.kind == driftlab::server::ClusterKind::kSlurm &&
         !fs::is_regular_file(options.cluster.driftlab_binary)) {
-      fmt::print(stderr, "error: --cluster-driftlab: {} is not a file (the driftlab binary the "
-                 "Slurm tasks run)\n", options.cluster.driftlab_binary.string());
+      fmt::print(stderr,
+                 "error: --cluster-driftlab: {} is not a file (the driftlab binary the "
+                 "Slurm tasks run)\n",
+                 options.cluster.driftlab_binary.string());
       return 2;
     }
     if (options.cluster.kind == driftlab::server::ClusterKind::kKubernetes &&
         !fs::is_regular_file(options.cluster.k8s_template)) {
-      fmt::print(stderr, "error: --k8s-template: {} is not a file (the Indexed Job template, "
-                 "deploy/k8s/server-shard-job.yaml)\n", options.cluster.k8s_template.string());
+      fmt::print(stderr,
+                 "error: --k8s-template: {} is not a file (the Indexed Job template, "
+                 "deploy/k8s/server-shard-job.yaml)\n",
+                 options.cluster.k8s_template.string());
       return 2;
     }
   }

@@ -103,8 +103,7 @@ TEST(KubernetesJobStatus, ConditionsWithStatusFalseAreIgnored) {
 TEST(KubernetesJobStatus, RejectsWhatIsNotAJob) {
   EXPECT_THROW(ParseKubernetesJob("not json", 4), ClusterError);
   EXPECT_THROW(ParseKubernetesJob(R"({"kind": "Pod"})", 4), ClusterError);
-  EXPECT_THROW(ParseKubernetesJob(R"({"kind": "Job", "status": {"active": -1}})", 4),
-               ClusterError);
+  EXPECT_THROW(ParseKubernetesJob(R"({"kind": "Job", "status": {"active": -1}})", 4), ClusterError);
   EXPECT_THROW(ParseKubernetesJob(R"({"kind": "Job", "status": {"completedIndexes": "9"}})", 4),
                ClusterError);
 }
@@ -144,16 +143,15 @@ TEST(KubernetesManifest, TemplateGivesAnIndexedJobWithTheShardCommand) {
   std::vector<std::string> args;
   for (const YAML::Node& a : container["args"]) args.push_back(a.as<std::string>());
   const std::string dir = "/shards/a \"quoted\" dir/job-0123456789abcdef01234567";
-  EXPECT_EQ(args, (std::vector<std::string>{"run", dir + "/job.json", "--quiet",
-                                            "--shard=$(JOB_COMPLETION_INDEX)/4",
-                                            "--out=" + dir + "/shard-$(JOB_COMPLETION_INDEX).json",
-                                            "--runs", "8"}));
+  EXPECT_EQ(args, (std::vector<std::string>{
+                      "run", dir + "/job.json", "--quiet", "--shard=$(JOB_COMPLETION_INDEX)/4",
+                      "--out=" + dir + "/shard-$(JOB_COMPLETION_INDEX).json", "--runs", "8"}));
   EXPECT_EQ(container["volumeMounts"][0]["mountPath"].as<std::string>(), p.work_dir);
   EXPECT_EQ(container["volumeMounts"][0]["name"].as<std::string>(),
             spec["template"]["spec"]["volumes"][0]["name"].as<std::string>());
-  EXPECT_EQ(
-      spec["template"]["spec"]["volumes"][0]["persistentVolumeClaim"]["claimName"].as<std::string>(),
-      "driftlab-shards");
+  EXPECT_EQ(spec["template"]["spec"]["volumes"][0]["persistentVolumeClaim"]["claimName"]
+                .as<std::string>(),
+            "driftlab-shards");
 }
 
 TEST(KubernetesManifest, UnknownPlaceholderIsNamed) {

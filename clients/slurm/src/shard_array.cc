@@ -203,9 +203,9 @@ std::optional<ShardProgress> ShardArray::Poll(std::vector<std::string>* notes,
   for (const uint32_t i : failed) {
     if (attempts_[i] >= options_.max_attempts) {
       Cancel();
-      throw SlurmError(fmt::format(
-          "shard {}/{} failed {} times (log {}: {}); the other shards were cancelled", i, k,
-          attempts_[i], LogPath(i).string(), LastLine(LogPath(i))));
+      throw SlurmError(
+          fmt::format("shard {}/{} failed {} times (log {}: {}); the other shards were cancelled",
+                      i, k, attempts_[i], LogPath(i).string(), LastLine(LogPath(i))));
     }
     std::string again;
     try {
@@ -216,9 +216,9 @@ std::optional<ShardProgress> ShardArray::Poll(std::vector<std::string>* notes,
     }
     ++attempts_[i];
     ++progress.queued;
-    notes->push_back(fmt::format(
-        "slurm: shard {}/{} ended without a result (log {}: {}); resubmitted as job {}", i, k,
-        LogPath(i).string(), LastLine(LogPath(i)), again));
+    notes->push_back(
+        fmt::format("slurm: shard {}/{} ended without a result (log {}: {}); resubmitted as job {}",
+                    i, k, LogPath(i).string(), LastLine(LogPath(i)), again));
   }
   return progress;
 }

@@ -39,7 +39,7 @@ struct ClusterOptions {
   ClusterKind kind = ClusterKind::kNone;
   // Jobs with samples_total (runs x samples per run) above this go to the cluster.
   uint64_t threshold_samples = 100'000'000;
-  uint32_t shards = 4;  // at most the job's runs
+  uint32_t shards = 4;             // at most the job's runs
   std::filesystem::path work_dir;  // absolute; DIR/<job-id>/ per job
   // Slurm: the `driftlab` the array tasks run (default: beside driftlab-server).
   std::filesystem::path driftlab_binary;
@@ -97,8 +97,7 @@ class ClusterRun {
 uint32_t ClusterShardCount(const ClusterOptions& options, uint32_t runs);
 
 // The backend of options.kind for the job `job_id` (never kNone).
-std::unique_ptr<ClusterRun> MakeClusterRun(const ClusterOptions& options,
-                                           const std::string& job_id,
+std::unique_ptr<ClusterRun> MakeClusterRun(const ClusterOptions& options, const std::string& job_id,
                                            const v1::SubmitJobRequest& request, uint32_t runs);
 
 // Writes DIR/job.json (the request's job as proto JSON, field names as in job files) and returns
@@ -112,12 +111,12 @@ std::vector<std::string> WriteClusterJobFile(const std::filesystem::path& dir,
 // Kubernetes API reference, "Job v1 batch" / JobStatus
 // (https://kubernetes.io/docs/reference/kubernetes-api/workload-resources/job-v1/).
 struct KubernetesJobStatus {
-  uint32_t active = 0;     // .status.active: pending and running pods
-  uint32_t succeeded = 0;  // .status.succeeded
-  uint32_t failed = 0;     // .status.failed: pods that failed (retries included)
+  uint32_t active = 0;                   // .status.active: pending and running pods
+  uint32_t succeeded = 0;                // .status.succeeded
+  uint32_t failed = 0;                   // .status.failed: pods that failed (retries included)
   std::set<uint32_t> completed_indexes;  // .status.completedIndexes, "1,3-5,7"
   std::set<uint32_t> failed_indexes;     // .status.failedIndexes (backoffLimitPerIndex)
-  bool complete = false;  // condition Complete (or SuccessCriteriaMet) with status "True"
+  bool complete = false;    // condition Complete (or SuccessCriteriaMet) with status "True"
   bool failed_job = false;  // condition Failed (or FailureTarget) with status "True"
   std::string failure;      // that condition's "reason: message"
 };
@@ -134,13 +133,13 @@ ClusterProgress KubernetesProgress(const KubernetesJobStatus& status, uint32_t c
 
 // What the template's ${...} placeholders become.
 struct KubernetesJobParameters {
-  std::string name;       // ${NAME}: the Job's name, "driftlab-" + job id
-  std::string name_space; // ${NAMESPACE}
-  std::string job_id;     // ${JOB_ID}: a label
-  std::string image;      // ${IMAGE}
-  uint32_t shards = 1;    // ${SHARDS}: completions and parallelism
-  std::string claim;      // ${CLAIM}: the ReadWriteMany volume claim holding ${WORK_DIR}
-  std::string work_dir;   // ${WORK_DIR}: where the claim is mounted (the server's --cluster-dir)
+  std::string name;        // ${NAME}: the Job's name, "driftlab-" + job id
+  std::string name_space;  // ${NAMESPACE}
+  std::string job_id;      // ${JOB_ID}: a label
+  std::string image;       // ${IMAGE}
+  uint32_t shards = 1;     // ${SHARDS}: completions and parallelism
+  std::string claim;       // ${CLAIM}: the ReadWriteMany volume claim holding ${WORK_DIR}
+  std::string work_dir;    // ${WORK_DIR}: where the claim is mounted (the server's --cluster-dir)
   std::vector<std::string> args;  // ${ARGS}: the container's args, written as a JSON array
 };
 // The template with its placeholders replaced (strings JSON-escaped: the template puts them in
