@@ -201,6 +201,7 @@ struct JobManager::LiveJob {
   std::atomic<bool> cancel{false};
   CancelReason reason = CancelReason::kNone;  // guarded by mutex_
   bool running = false;
+  bool on_cluster = false;  // set when a worker hands it to RunClusterJob
   MonteCarloProgress progress;
   SteadyClock::time_point started;
   uint64_t version = 0;  // bumped at every change Watch reports
@@ -234,8 +235,9 @@ grpc::Status NotFound(const std::string& job_id) {
 
 }  // namespace
 
-JobManager::JobManager(JobStore* store, const ServerLimits& limits, std::string version)
-    : store_(store), limits_(limits), version_(std::move(version)) {
+JobManager::JobManager(JobStore* store, const ServerLimits& limits, std::string version,
+                       ClusterOptions cluster)
+    : store_(store), limits_(limits), version_(std::move(version)), cluster_(std::move(cluster)) {
   limits_.max_concurrent_jobs = std::max<uint32_t>(1, limits_.max_concurrent_jobs);
   threads_per_job_ = limits_.threads_per_job > 0
                          ? limits_.threads_per_job
@@ -272,8 +274,10 @@ void JobManager::Shutdown(std::chrono::milliseconds grace) {
   accepting_ = false;
   draining_ = true;
   changed_.notify_all();
+  // Jobs on a cluster are not waited for: their shards keep running and a restart re-attaches.
   const auto any_running = [this] {
-    return std::any_of(live_.begin(), live_.end(), [](const auto& e) { return e.second->running; });
+    return std::any_of(live_.begin(), live_.end(),
+                       [](const auto& e) { return e.second->running && !e.second->on_cluster; });
   };
   if (any_running()) {
     spdlog::info("shutdown: waiting up to {} ms for running jobs", grace.count());
@@ -288,6 +292,11 @@ void JobManager::Shutdown(std::chrono::milliseconds grace) {
   lock.unlock();
   for (std::thread& worker : workers_) worker.join();
   workers_.clear();
+  lock.lock();
+  std::vector<ClusterThread> cluster_threads = std::move(cluster_threads_);
+  cluster_threads_.clear();
+  lock.unlock();
+  for (ClusterThread& t : cluster_threads) t.thread.join();
   lock.lock();
   stopped_ = true;
   changed_.notify_all();
@@ -561,23 +570,177 @@ void JobManager::WorkerLoop() {
       if (queued > 0) --queued;
       live->running = true;
       live->started = SteadyClock::now();
+      live->on_cluster = UsesCluster(live->row);
+      if (live->on_cluster) {
+        // Join the threads of cluster jobs that ended, then start this one's.
+        std::erase_if(cluster_threads_, [](ClusterThread& t) {
+          if (!t.finished->load()) return false;
+          t.thread.join();
+          return true;
+        });
+        auto finished = std::make_shared<std::atomic<bool>>(false);
+        cluster_threads_.push_back({std::thread([this, live, finished] {
+                                      RunClusterJob(live);
+                                      finished->store(true);
+                                    }),
+                                    finished});
+        continue;
+      }
     }
     RunJob(live);
   }
 }
 
+bool JobManager::UsesCluster(const StoredJob& row) const {
+  if (cluster_.kind == ClusterKind::kNone) {
+    if (!row.cluster.empty()) {
+      spdlog::warn(
+          "job={} was handed to a cluster ({}) but this server has no --cluster: it runs "
+          "in-process",
+          row.id, row.cluster);
+    }
+    return false;
+  }
+  if (!row.cluster.empty()) return true;
+  if (row.samples_total <= cluster_.threshold_samples) return false;
+  v1::SubmitJobRequest request;
+  return request.ParseFromString(row.request) && request.shard().empty();
+}
+
+uint32_t JobManager::MarkRunning(const std::shared_ptr<LiveJob>& live) {
+  const double started_unix_s = UnixNow();
+  const uint32_t attempts = store_->MarkRunning(live->row.id, started_unix_s);
+  std::lock_guard lock(mutex_);
+  live->row.state = v1::RUNNING;
+  live->row.started_unix_s = started_unix_s;
+  live->row.attempts = attempts;
+  ++live->version;
+  changed_.notify_all();
+  return attempts;
+}
+
+void JobManager::RunClusterJob(const std::shared_ptr<LiveJob>& live) {
+  // How often the cluster is asked for the shards' state (one squeue / kubectl get).
+  constexpr auto kClusterPoll = std::chrono::milliseconds(500);
+  const std::string& id = live->row.id;
+  const uint32_t attempts = MarkRunning(live);
+  const uint32_t runs = live->row.runs_total;
+  const uint64_t samples_per_run = runs > 0 ? live->row.samples_total / runs : 0;
+
+  v1::JobState final_state = v1::FAILED;
+  std::string error;
+  bool requeue = false;
+  try {
+    v1::SubmitJobRequest request;
+    if (!request.ParseFromString(live->row.request)) {
+      throw std::runtime_error("the stored request cannot be parsed");
+    }
+    std::unique_ptr<ClusterRun> run = MakeClusterRun(cluster_, id, request, runs);
+    const uint32_t k = run->shards();
+    if (live->row.cluster.empty()) {
+      run->Submit();
+      spdlog::info("job={} owner={} state=RUNNING runs={} attempt={} cluster=\"{}\" shards={}", id,
+                   live->row.owner, runs, attempts, run->Handle(), k);
+    } else {
+      run->Attach(live->row.cluster);
+      spdlog::info(
+          "job={} owner={} state=RUNNING runs={} attempt={} cluster=\"{}\" shards={} "
+          "(re-attached)",
+          id, live->row.owner, runs, attempts, run->Handle(), k);
+    }
+    std::string handle = run->Handle();
+    store_->SetCluster(id, handle);
+    std::string last_text, last_warning;
+    for (;;) {
+      CancelReason reason = CancelReason::kNone;
+      {
+        std::lock_guard lock(mutex_);
+        if (live->cancel.load()) reason = live->reason;
+      }
+      if (reason == CancelReason::kShutdown) {
+        requeue = true;  // the shards keep running; the next server re-attaches
+        break;
+      }
+      if (reason != CancelReason::kNone) {
+        if (!run->Cancel()) spdlog::warn("job={} cancelling {} failed", id, handle);
+        final_state = v1::CANCELLED;
+        error = reason == CancelReason::kDeadline ? "deadline exceeded" : "cancelled by its owner";
+        break;
+      }
+      std::vector<std::string> notes;
+      std::string warning;
+      const std::optional<ClusterProgress> progress = run->Poll(&notes, &warning);
+      for (const std::string& note : notes) spdlog::info("job={} {}", id, note);
+      if (run->Handle() != handle) {
+        handle = run->Handle();
+        store_->SetCluster(id, handle);
+      }
+      if (!progress) {
+        if (warning != last_warning) spdlog::warn("job={} {}", id, warning);
+        last_warning = warning;
+      } else {
+        if (progress->text != last_text) spdlog::info("job={} {}", id, progress->text);
+        last_text = progress->text;
+        // Runs of the shards done: shard i holds runs [floor(i N / K), floor((i + 1) N / K)).
+        uint32_t runs_done = 0;
+        for (const uint32_t i : progress->done_shards) {
+          runs_done += static_cast<uint32_t>((uint64_t{i} + 1) * runs / k - uint64_t{i} * runs / k);
+        }
+        {
+          std::lock_guard lock(mutex_);
+          live->progress.runs_done = runs_done;
+          live->progress.runs_total = runs;
+          live->progress.samples_done = static_cast<int64_t>(runs_done * samples_per_run);
+          live->progress.samples_total = static_cast<int64_t>(live->row.samples_total);
+          live->progress.elapsed_s =
+              std::chrono::duration<double>(SteadyClock::now() - live->started).count();
+          ++live->version;
+          changed_.notify_all();
+        }
+        if (progress->done == progress->total) {
+          const v1::JobResult result = run->Merge(version_);
+          store_->StoreResult(id, SerializeDeterministic(result), UnixNow());
+          final_state = v1::SUCCEEDED;
+          break;
+        }
+      }
+      std::unique_lock lock(mutex_);
+      changed_.wait_for(lock, kClusterPoll, [&] { return live->cancel.load(); });
+    }
+  } catch (const ClusterError& e) {
+    error = std::string("cluster: ") + MessageText(e.what(), kMaxMessageTextBytes);
+  } catch (const SpecError& e) {
+    error = e.what();
+  } catch (const std::exception& e) {
+    error = std::string("internal error: ") + MessageText(e.what(), kMaxMessageTextBytes);
+  }
+  if (requeue) {
+    store_->Requeue(id);
+  } else if (final_state != v1::SUCCEEDED) {
+    store_->MarkFinished(id, final_state, error, UnixNow());
+  }
+  const double seconds = std::chrono::duration<double>(SteadyClock::now() - live->started).count();
+  std::lock_guard lock(mutex_);
+  samples_finished_ += static_cast<uint64_t>(live->progress.samples_done);
+  live_.erase(id);
+  changed_.notify_all();
+  if (requeue) {
+    spdlog::info(
+        "job={} owner={} state=QUEUED runs={} seconds={:.3f} (shutdown; its shards keep "
+        "running)",
+        id, live->row.owner, runs, seconds);
+  } else if (final_state == v1::SUCCEEDED) {
+    spdlog::info("job={} owner={} state=SUCCEEDED runs={} seconds={:.3f}", id, live->row.owner,
+                 runs, seconds);
+  } else {
+    spdlog::info("job={} owner={} state={} runs={} seconds={:.3f} error=\"{}\"", id,
+                 live->row.owner, v1::JobState_Name(final_state), runs, seconds, error);
+  }
+}
+
 void JobManager::RunJob(const std::shared_ptr<LiveJob>& live) {
   const std::string& id = live->row.id;
-  const double started_unix_s = UnixNow();
-  const uint32_t attempts = store_->MarkRunning(id, started_unix_s);
-  {
-    std::lock_guard lock(mutex_);
-    live->row.state = v1::RUNNING;
-    live->row.started_unix_s = started_unix_s;
-    live->row.attempts = attempts;
-    ++live->version;
-    changed_.notify_all();
-  }
+  const uint32_t attempts = MarkRunning(live);
   spdlog::info("job={} owner={} state=RUNNING runs={} attempt={} threads={}", id, live->row.owner,
                live->row.runs_total, attempts, threads_per_job_);
 

@@ -37,7 +37,7 @@ CREATE TRIGGER IF NOT EXISTS jobs_result_kept BEFORE DELETE ON jobs
 
 constexpr const char* kColumns =
     "seq, id, owner, state, request, name, runs_total, samples_total, error, submitted_unix_s, "
-    "started_unix_s, finished_unix_s, deadline_unix_s, attempts, result IS NOT NULL";
+    "started_unix_s, finished_unix_s, deadline_unix_s, attempts, result IS NOT NULL, cluster";
 
 // A prepared statement, finalized on scope exit.
 class Statement {
@@ -118,6 +118,7 @@ StoredJob ReadRow(const Statement& s) {
   job.deadline_unix_s = s.OptionalReal(12);
   job.attempts = static_cast<uint32_t>(s.Int(13));
   job.has_result = s.Int(14) != 0;
+  job.cluster = s.Bytes(15);
   return job;
 }
 
@@ -138,6 +139,13 @@ JobStore::JobStore(const std::filesystem::path& data_dir) {
   Exec("PRAGMA journal_mode=WAL");
   Exec("PRAGMA synchronous=FULL");
   Exec(kSchema);
+  // Added with the cluster backends: a store written before them gets the column (empty).
+  bool has_cluster = false;
+  {
+    Statement s(db_, "SELECT name FROM pragma_table_info('jobs')");
+    while (s.Step()) has_cluster = has_cluster || s.Bytes(0) == "cluster";
+  }
+  if (!has_cluster) Exec("ALTER TABLE jobs ADD COLUMN cluster TEXT NOT NULL DEFAULT ''");
 }
 
 JobStore::~JobStore() { sqlite3_close(db_); }
@@ -242,6 +250,13 @@ std::vector<StoredJob> JobStore::RecoverQueued() {
   std::vector<StoredJob> jobs;
   while (s.Step()) jobs.push_back(ReadRow(s));
   return jobs;
+}
+
+void JobStore::SetCluster(const std::string& id, const std::string& cluster) {
+  std::lock_guard lock(mutex_);
+  Statement s(db_, "UPDATE jobs SET cluster = ? WHERE id = ?");
+  s.Bind(1, cluster).Bind(2, id);
+  s.Step();
 }
 
 std::optional<std::string> JobStore::GetResult(const std::string& id) const {

@@ -3,6 +3,9 @@
 //   driftlab-server --listen ADDR --data DIR [--tls-cert F --tls-key F] [--tokens FILE]
 //       [--max-concurrent-jobs N] [--max-queued-jobs N] [--max-job-samples N]
 //       [--threads-per-job N] [--examples DIR] [--port-file F] [--shutdown-grace-s S]
+//       [--cluster slurm|k8s --cluster-dir DIR [--cluster-threshold-samples N] [--cluster-shards K]
+//        [--slurm-partition P] [--cluster-driftlab PATH]
+//        [--k8s-template F] [--k8s-image I] [--k8s-namespace NS] [--k8s-claim C]]
 //   driftlab-server hash-token TOKEN      prints the SHA-256 to put in a tokens file
 //
 // The first line on stdout is "listening on HOST:PORT" (with the bound port when ADDR ends in
@@ -13,15 +16,16 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <optional>
 #include <string>
 
+#include "driftlab/output_files.h"
 #include "driftlab/server/auth.h"
 #include "driftlab/server/server.h"
-#include "driftlab/output_files.h"
 #include "driftlab/spec_error.h"
 
 namespace {
@@ -85,6 +89,35 @@ int main(int argc, char** argv) {
                  "On SIGTERM, running jobs may finish for this long before they are requeued")
       ->check(CLI::Range(0.0, 86400.0))
       ->capture_default_str();
+  std::string cluster_kind = "none";
+  std::string cluster_dir, cluster_driftlab, k8s_template;
+  app.add_option("--cluster", cluster_kind,
+                 "Run jobs over --cluster-threshold-samples on a cluster: none, slurm or k8s")
+      ->check(CLI::IsMember({"none", "slurm", "k8s"}))
+      ->capture_default_str();
+  app.add_option("--cluster-threshold-samples", options.cluster.threshold_samples,
+                 "Jobs with more runs x IMU samples than this go to the cluster")
+      ->capture_default_str();
+  app.add_option("--cluster-shards", options.cluster.shards,
+                 "Shards of a cluster job (at most its runs)")
+      ->check(CLI::Range(1u, 100000u))
+      ->capture_default_str();
+  app.add_option("--cluster-dir", cluster_dir,
+                 "Shared directory of cluster jobs (same path on the nodes / in the pods)");
+  app.add_option("--cluster-driftlab", cluster_driftlab,
+                 "The driftlab binary Slurm tasks run (default: beside driftlab-server)");
+  app.add_option("--slurm-partition", options.cluster.slurm_partition,
+                 "Slurm partition (default: the cluster's default)");
+  app.add_option("--k8s-template", k8s_template,
+                 "Indexed Job template (default: deploy/k8s/server-shard-job.yaml installed in "
+                 "/usr/share/driftlab)");
+  app.add_option("--k8s-image", options.cluster.k8s_image, "Image of the shard pods")
+      ->capture_default_str();
+  app.add_option("--k8s-namespace", options.cluster.k8s_namespace, "Namespace of the Jobs")
+      ->capture_default_str();
+  app.add_option("--k8s-claim", options.cluster.k8s_claim,
+                 "ReadWriteMany claim mounted at --cluster-dir in the shard pods")
+      ->capture_default_str();
   std::string token;
   CLI::App* hash = app.add_subcommand("hash-token", "Print the SHA-256 of TOKEN for a tokens file");
   hash->add_option("token", token, "The bearer token")->required();
@@ -99,6 +132,43 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "error: --data DIR is required\n");
     return 2;
   }
+
+  if (cluster_kind != "none") {
+    if (cluster_dir.empty()) {
+      fmt::print(stderr,
+                 "error: --cluster {} needs --cluster-dir DIR (a directory the {} can "
+                 "read and write at the same path)\n",
+                 cluster_kind, cluster_kind == "slurm" ? "compute nodes" : "shard pods");
+      return 2;
+    }
+    namespace fs = std::filesystem;
+    options.cluster.kind = cluster_kind == "slurm" ? driftlab::server::ClusterKind::kSlurm
+                                                   : driftlab::server::ClusterKind::kKubernetes;
+    options.cluster.work_dir = fs::absolute(cluster_dir);
+    options.cluster.driftlab_binary =
+        cluster_driftlab.empty() ? fs::read_symlink("/proc/self/exe").parent_path() / "driftlab"
+                                 : fs::absolute(cluster_driftlab);
+    options.cluster.k8s_template = k8s_template.empty()
+                                       ? fs::path("/usr/share/driftlab/k8s/server-shard-job.yaml")
+                                       : fs::path(k8s_template);
+    if (options.cluster.kind == driftlab::server::ClusterKind::kSlurm &&
+        !fs::is_regular_file(options.cluster.driftlab_binary)) {
+      fmt::print(stderr,
+                 "error: --cluster-driftlab: {} is not a file (the driftlab binary the "
+                 "Slurm tasks run)\n",
+                 options.cluster.driftlab_binary.string());
+      return 2;
+    }
+    if (options.cluster.kind == driftlab::server::ClusterKind::kKubernetes &&
+        !fs::is_regular_file(options.cluster.k8s_template)) {
+      fmt::print(stderr,
+                 "error: --k8s-template: {} is not a file (the Indexed Job template, "
+                 "deploy/k8s/server-shard-job.yaml)\n",
+                 options.cluster.k8s_template.string());
+      return 2;
+    }
+  }
+  std::signal(SIGPIPE, SIG_IGN);  // a cluster client that exits before reading its input
 
   driftlab::server::BlockShutdownSignals();  // before any thread exists
 

@@ -107,7 +107,8 @@ Server::Server(const ServerOptions& options) : options_(options) {
     spdlog::warn("no --tokens file: every call is accepted as owner \"{}\"", kAnonymousOwner);
   }
   store_ = std::make_unique<JobStore>(options.data_dir);
-  manager_ = std::make_unique<JobManager>(store_.get(), options.limits, DRIFTLAB_VERSION);
+  manager_ =
+      std::make_unique<JobManager>(store_.get(), options.limits, DRIFTLAB_VERSION, options.cluster);
 
   grpc::EnableDefaultHealthCheckService(true);
   grpc::reflection::InitProtoReflectionServerBuilderPlugin();

@@ -15,34 +15,13 @@ Everything is stopped at the end. Exits 77 (ctest: skipped) with a message when 
 missing or the test does not run as root (slurmd must); CI installs them (.ci/run).
 """
 
-import os
 import pathlib
 import re
-import shutil
 import signal
-import socket
 import subprocess
 import sys
-import tempfile
-import time
 
-SKIP = 77
-
-
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def wait_until(predicate, timeout_s, what):
-    """Polls predicate every 0.2 s for at most timeout_s (a bounded loop)."""
-    end = time.monotonic() + timeout_s
-    while time.monotonic() < end:
-        if predicate():
-            return
-        time.sleep(0.2)
-    raise AssertionError(f"timed out after {timeout_s} s waiting for {what}")
+from slurm_cluster import SKIP, Skip, SlurmCluster, wait_until
 
 
 def without_timings(text):
@@ -52,72 +31,14 @@ def without_timings(text):
 def main():
     source, build = map(pathlib.Path, sys.argv[1:3])
     driftlab = build / "driftlab"
-    missing = [p for p in ("munged", "slurmctld", "slurmd", "sbatch", "squeue", "scancel")
-               if shutil.which(p) is None and not pathlib.Path("/usr/sbin", p).exists()]
-    if missing:
-        print(f"SKIP: Slurm packages missing ({', '.join(missing)}): apt-get install slurm-wlm "
-              "munge")
-        return SKIP
-    if os.geteuid() != 0:
-        print("SKIP: slurmd must run as root to start jobs; run this test as root")
-        return SKIP
-
-    tmp = pathlib.Path(tempfile.mkdtemp(prefix="driftlab_slurm_"))
-    daemons = []
-    env = dict(os.environ)
     try:
-        (tmp / "munge").mkdir(mode=0o700)
-        (tmp / "state").mkdir()
-        (tmp / "spool").mkdir()
-        key = tmp / "munge" / "munge.key"
-        key.write_bytes(os.urandom(1024))
-        key.chmod(0o400)
-        socket_path = tmp / "munge" / "munge.socket"
-        subprocess.run(["/usr/sbin/munged", f"--key-file={key}", f"--socket={socket_path}",
-                        f"--pid-file={tmp / 'munge' / 'munged.pid'}",
-                        f"--log-file={tmp / 'munge' / 'munged.log'}",
-                        f"--seed-file={tmp / 'munge' / 'seed'}", "--force"], check=True)
-        host = socket.gethostname().split(".")[0]
-        conf = tmp / "slurm.conf"
-        conf.write_text(f"""ClusterName=driftlabtest
-SlurmctldHost={host}(127.0.0.1)
-SlurmctldPort={free_port()}
-SlurmdPort={free_port()}
-AuthType=auth/munge
-AuthInfo=socket={socket_path}
-CredType=cred/munge
-StateSaveLocation={tmp / 'state'}
-SlurmdSpoolDir={tmp / 'spool'}
-SlurmctldPidFile={tmp / 'slurmctld.pid'}
-SlurmdPidFile={tmp / 'slurmd.pid'}
-SlurmctldLogFile={tmp / 'slurmctld.log'}
-SlurmdLogFile={tmp / 'slurmd.log'}
-SlurmUser=root
-SlurmdUser=root
-ProctrackType=proctrack/linuxproc
-TaskPlugin=task/none
-SelectType=select/cons_tres
-SelectTypeParameters=CR_Core
-SchedulerType=sched/builtin
-ReturnToService=2
-MpiDefault=none
-JobAcctGatherType=jobacct_gather/none
-AccountingStorageType=accounting_storage/none
-NodeName={host} NodeAddr=127.0.0.1 CPUs={os.cpu_count()} RealMemory=1000 State=UNKNOWN
-PartitionName=test Nodes={host} Default=YES MaxTime=INFINITE State=UP
-""")
-        env["SLURM_CONF"] = str(conf)
-        for daemon in ("slurmctld", "slurmd"):
-            daemons.append(subprocess.Popen([f"/usr/sbin/{daemon}", "-D", "-f", str(conf)],
-                                            env=env, stdout=subprocess.DEVNULL,
-                                            stderr=subprocess.DEVNULL))
-
-        def node_idle():
-            r = subprocess.run(["sinfo", "-h", "-o", "%T"], env=env, capture_output=True,
-                               text=True)
-            return r.returncode == 0 and "idle" in r.stdout
-        wait_until(node_idle, 60, "the Slurm node to be idle")
-
+        cluster = SlurmCluster()
+    except Skip as reason:
+        print(f"SKIP: {reason}")
+        return SKIP
+    with cluster:
+        tmp = cluster.tmp
+        env = cluster.env
         job = source / "tests" / "cli" / "data" / "mc_small.json"
         # 1. Four shards through Slurm equal one in-process run.
         slurm_out = tmp / "slurm.json"
@@ -193,10 +114,7 @@ PartitionName=test Nodes={host} Default=YES MaxTime=INFINITE State=UP
                                    text=True)
 
         def our_tasks(state=None):
-            q = subprocess.run(["squeue", "-h", "-r", "-o", "%j %T"], env=env,
-                               capture_output=True, text=True)
-            return [line for line in q.stdout.splitlines()
-                    if line.startswith("driftlab ") and (state is None or line.endswith(state))]
+            return cluster.tasks("driftlab ", state)
         wait_until(lambda: our_tasks("RUNNING"), 60, "a running task")
         process.send_signal(signal.SIGINT)
         _, err = process.communicate(timeout=60)
@@ -206,21 +124,6 @@ PartitionName=test Nodes={host} Default=YES MaxTime=INFINITE State=UP
         assert not cancel_out.exists()
         print("ok: SIGINT cancelled the array (exit 130, queue empty)")
         return 0
-    finally:
-        for daemon in daemons:
-            daemon.terminate()
-        for daemon in daemons:
-            try:
-                daemon.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                daemon.kill()
-        pid_file = tmp / "munge" / "munged.pid"
-        if pid_file.exists():
-            try:
-                os.kill(int(pid_file.read_text().strip()), signal.SIGTERM)
-            except (OSError, ValueError):
-                pass
-        shutil.rmtree(tmp, ignore_errors=True)
 
 
 if __name__ == "__main__":

@@ -56,6 +56,34 @@ TEST(JobStoreTest, StoredResultIsNeverOverwrittenOrDeleted) {
   EXPECT_EQ(store.Get("a")->state, v1::SUCCEEDED);
 }
 
+TEST(JobStoreTest, ClusterHandleSurvivesRecoveryAndOldStoresGetTheColumn) {
+  Scratch scratch;
+  const fs::path db = scratch.dir() / "driftlab.db";
+  // A store written before the cluster backends: the jobs table without the `cluster` column.
+  ASSERT_EQ(
+      ExecOnFile(db,
+                 "CREATE TABLE jobs (seq INTEGER PRIMARY KEY AUTOINCREMENT, id TEXT NOT NULL "
+                 "UNIQUE, owner TEXT NOT NULL, state INTEGER NOT NULL, request BLOB NOT NULL, "
+                 "name TEXT NOT NULL, runs_total INTEGER NOT NULL, samples_total INTEGER NOT "
+                 "NULL, error TEXT NOT NULL DEFAULT '', submitted_unix_s REAL NOT NULL, "
+                 "started_unix_s REAL, finished_unix_s REAL, deadline_unix_s REAL, attempts "
+                 "INTEGER NOT NULL DEFAULT 0, result BLOB)"),
+      SQLITE_OK);
+  {
+    server::JobStore store(scratch.dir());
+    server::StoredJob job = NewJob("a", "alice");
+    store.Insert(&job);
+    EXPECT_EQ(store.Get("a")->cluster, "");
+    store.MarkRunning("a", 1.7e9 + 1);
+    store.SetCluster("a", "slurm 12 15");
+  }
+  server::JobStore reopened(scratch.dir());  // as after a crash: RUNNING goes back to QUEUED
+  const std::vector<server::StoredJob> queued = reopened.RecoverQueued();
+  ASSERT_EQ(queued.size(), 1u);
+  EXPECT_EQ(queued[0].cluster, "slurm 12 15");
+  EXPECT_EQ(queued[0].attempts, 1u);
+}
+
 TEST(JobStoreTest, RecoveryReturnsRunningJobsToTheQueueInSubmissionOrderWithAttemptsKept) {
   Scratch scratch;
   {

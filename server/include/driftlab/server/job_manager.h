@@ -13,6 +13,14 @@
 // std::atomic<bool>, which the engine polls every 1024 samples of every run; Cancel returns when
 // the worker has stopped. Queued jobs are kept in memory (and in the store); progress lives in
 // memory only, state transitions go to the store (job_store.h).
+//
+// With a cluster backend (cluster.h), a job whose cost exceeds the threshold runs as shards on the
+// cluster: a worker hands it to a thread of its own that submits (or, after a restart, re-attaches
+// to) the shards, maps shard progress to runs_done / samples_done (the runs of the shards done),
+// cancels them on Cancel or the deadline, and stores the merged result. Such a job does not hold
+// one of max_concurrent_jobs; the per-owner queue limit and --max-job-samples apply as for every
+// job. At shutdown its shards keep running and the job goes back to QUEUED: the next server
+// process re-attaches to them (the handle is in the store).
 #pragma once
 
 #include <grpcpp/grpcpp.h>
@@ -31,6 +39,7 @@
 #include <vector>
 
 #include "driftlab/monte_carlo.h"
+#include "driftlab/server/cluster.h"
 #include "driftlab/server/job_store.h"
 #include "driftlab/server/service_common.h"
 #include "driftlab/v1/service.pb.h"
@@ -64,7 +73,8 @@ class JobManager {
  public:
   // `store` outlives the manager. limits.threads_per_job = 0 means hardware threads divided by
   // max_concurrent_jobs (at least 1).
-  JobManager(JobStore* store, const ServerLimits& limits, std::string version);
+  JobManager(JobStore* store, const ServerLimits& limits, std::string version,
+             ClusterOptions cluster = {});
   ~JobManager();
   JobManager(const JobManager&) = delete;
   JobManager& operator=(const JobManager&) = delete;
@@ -108,6 +118,13 @@ class JobManager {
   void WorkerLoop();
   void DeadlineLoop();
   void RunJob(const std::shared_ptr<LiveJob>& live);
+  // RunJob for a job on the cluster (cluster.h); runs on a thread of its own.
+  void RunClusterJob(const std::shared_ptr<LiveJob>& live);
+  // True when the job runs on the cluster: a backend is configured and the job is over its
+  // threshold (and not itself a shard), or it was handed to the cluster before a restart.
+  bool UsesCluster(const StoredJob& row) const;
+  // Marks the job RUNNING in the store and in memory; returns the attempt number.
+  uint32_t MarkRunning(const std::shared_ptr<LiveJob>& live);
   // Status of a job from its live entry (queued/running) or the store; mutex_ held for live.
   v1::JobStatus LiveStatus(const LiveJob& live) const;
   // Removes a queued job from the queue and the live map; mutex_ held.
@@ -131,6 +148,12 @@ class JobManager {
   uint64_t samples_finished_ = 0;  // samples of finished attempts since start
 
   std::vector<std::thread> workers_;
+  ClusterOptions cluster_;
+  struct ClusterThread {
+    std::thread thread;
+    std::shared_ptr<std::atomic<bool>> finished;
+  };
+  std::vector<ClusterThread> cluster_threads_;  // guarded by mutex_
   std::thread deadline_thread_;
 };
 

@@ -2,7 +2,9 @@
 //
 // Table `jobs`: id, owner, state (driftlab.v1.JobState number), the serialized SubmitJobRequest,
 // name, runs and samples of the job, the error text, timestamps (Unix seconds), the deadline
-// (Unix seconds, absent = none), attempts and the serialized JobResult. `seq` (INTEGER PRIMARY
+// (Unix seconds, absent = none), attempts, the serialized JobResult and `cluster`: where a job
+// handed to a cluster runs ("slurm 123 130": the array job ids; "k8s NAME": the Job's name), so a
+// restarted server re-attaches to it (cluster.h). `seq` (INTEGER PRIMARY
 // KEY) orders jobs by submission.
 //
 // Durability rules (DESIGN.md "Service", invariant 3):
@@ -48,6 +50,7 @@ struct StoredJob {
   std::optional<double> deadline_unix_s;
   uint32_t attempts = 0;
   bool has_result = false;
+  std::string cluster;  // "" = runs in the server's process (cluster.h)
 };
 
 class JobStore {
@@ -72,6 +75,8 @@ class JobStore {
   void Requeue(const std::string& id);
   // Start-up recovery: RUNNING -> QUEUED; returns every QUEUED job in submission order.
   std::vector<StoredJob> RecoverQueued();
+  // Records where the job runs on a cluster (kept through Requeue and RecoverQueued).
+  void SetCluster(const std::string& id, const std::string& cluster);
   std::optional<std::string> GetResult(const std::string& id) const;
   // The owner's jobs, newest first, with seq < before_seq (0 = from the newest), in `states`
   // (empty = all), at most `limit`.

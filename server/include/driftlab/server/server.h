@@ -12,6 +12,7 @@
 #include <string>
 
 #include "driftlab/server/auth.h"
+#include "driftlab/server/cluster.h"
 #include "driftlab/server/job_manager.h"
 #include "driftlab/server/job_store.h"
 #include "driftlab/server/service_common.h"
@@ -27,6 +28,7 @@ struct ServerOptions {
   std::optional<std::filesystem::path> tokens_file;  // absent: no authentication
   std::filesystem::path examples_dir;                // Catalog.ListExamples
   ServerLimits limits;
+  ClusterOptions cluster;  // kind kNone: every job runs in the server's process
   std::chrono::milliseconds shutdown_grace{10000};  // running jobs may finish for this long
 };
 
