@@ -1,0 +1,140 @@
+#!/usr/bin/python3
+"""Browser test of the HTML reports (issue 20): each report type, written by the CLI, loads in
+headless Chromium with no script error and every interactive plot drawn.
+
+Usage: browser_test.py DRIFTLAB_CLI WORK_DIR [--screenshots DIR]
+
+Report types: the Monte-Carlo report (`driftlab run --report`, examples/car_drive_gnss.json cut to
+20 runs: GNSS outage and ZUPT shading, NEES plot, scatter), the calibration report
+(`driftlab calibrate imu --report`, on tests/data/calib_imu_sample.csv) and the noise-fit report
+(`driftlab export` of a static recording, then `driftlab allan --fit --report`).
+
+Each page is loaded with `chromium --headless --disable-gpu --no-sandbox --dump-dom` after a
+virtual-time budget; report_plots.js marks each plot's element data-drawn="yes" when its canvas
+holds a non-transparent pixel and records uncaught errors in <html data-errors>. Chromium's
+console messages (--enable-logging=stderr) are checked for errors too. Exit 77 (ctest SKIP) when
+chromium is not installed.
+"""
+import os
+import re
+import shutil
+import subprocess
+import sys
+import json
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def chromium():
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        path = shutil.which(name)
+        if path:
+            return path
+    return None
+
+
+def run(cmd, cwd):
+    proc = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True, timeout=300)
+    if proc.returncode != 0:
+        raise SystemExit(f"FAILED: {' '.join(cmd)} exited {proc.returncode}\n{proc.stdout}\n"
+                         f"{proc.stderr}")
+    return proc
+
+
+def browser(exe, page, work, extra):
+    profile = os.path.join(work, "profile")
+    cmd = [exe, "--headless", "--disable-gpu", "--no-sandbox", "--no-first-run",
+           "--disable-extensions", "--disable-dev-shm-usage", f"--user-data-dir={profile}",
+           "--enable-logging=stderr", "--v=0", "--virtual-time-budget=10000",
+           "--window-size=1280,900"] + extra + ["file://" + os.path.abspath(page)]
+    return subprocess.run(cmd, cwd=work, capture_output=True, text=True, timeout=120)
+
+
+def write_reports(cli, work):
+    reports = {}
+    job = json.load(open(os.path.join(ROOT, "examples", "car_drive_gnss.json")))
+    job["monte_carlo"]["runs"] = 20
+    job_path = os.path.join(work, "car_drive_gnss.json")
+    json.dump(job, open(job_path, "w"))
+    run([cli, "run", job_path, "--out", os.path.join(work, "mc.json"), "--report",
+         os.path.join(work, "monte_carlo.html")], work)
+    reports["monte_carlo"] = os.path.join(work, "monte_carlo.html")
+
+    calib_csv = os.path.join(ROOT, "tests", "data", "calib_imu_sample.csv")
+    run([cli, "calibrate", "imu", calib_csv, "--out", os.path.join(work, "calib.json"),
+         "--report", os.path.join(work, "calibration.html")], work)
+    reports["calibration"] = os.path.join(work, "calibration.html")
+
+    static_job = os.path.join(work, "static.json")
+    json.dump({"name": "static_stim300", "motion": {"initial": {"lat_deg": 45.0},
+               "segments": [{"static": {"duration_s": 1200}}]}, "rate_hz": 100,
+               "sensor": {"preset": "stim300"}}, open(static_job, "w"))
+    run([cli, "export", static_job, "--out", os.path.join(work, "static_export")], work)
+    imu_csv = None
+    for dirpath, _, files in os.walk(os.path.join(work, "static_export")):
+        for f in files:
+            if f.startswith("imu") and f.endswith(".csv"):
+                imu_csv = os.path.join(dirpath, f)
+    if imu_csv is None:
+        raise SystemExit("FAILED: driftlab export wrote no imu*.csv")
+    run([cli, "allan", imu_csv, "--fit", "--report", os.path.join(work, "noise_fit.html")], work)
+    reports["noise_fit"] = os.path.join(work, "noise_fit.html")
+    return reports
+
+
+def check(exe, name, page, work):
+    html = open(page, encoding="utf-8").read()
+    failures = []
+    expected = len(re.findall(r'class="dl-plot"', html))
+    if expected == 0:
+        failures.append(f"{name}: no interactive plot in the report")
+    if re.search(r'<(script|link|img)[^>]+(src|href)=', html):
+        failures.append(f"{name}: the report loads an external resource")
+    proc = browser(exe, page, work, ["--dump-dom"])
+    dom = proc.stdout
+    if "</html>" not in dom:
+        failures.append(f"{name}: chromium returned no DOM (exit {proc.returncode}): "
+                        f"{proc.stderr[-2000:]}")
+        return failures
+    drawn = len(re.findall(r'data-drawn="yes"', dom))
+    blank = len(re.findall(r'data-drawn="no"', dom))
+    if drawn != expected:
+        failures.append(f"{name}: {drawn} of {expected} plots drawn ({blank} blank)")
+    errors = re.search(r'data-errors="([^"]*)"', dom)
+    if errors:
+        failures.append(f"{name}: script errors: {errors.group(1)}")
+    for line in proc.stderr.splitlines():
+        if "CONSOLE" in line and ("Uncaught" in line or "ERROR" in line.split("CONSOLE")[0]
+                                  or "Error" in line):
+            failures.append(f"{name}: console: {line}")
+    print(f"{name}: {drawn}/{expected} plots drawn, {len(html)} bytes")
+    return failures
+
+
+def main():
+    if len(sys.argv) < 3:
+        raise SystemExit(__doc__)
+    cli, work = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
+    shots = None
+    if "--screenshots" in sys.argv:
+        shots = os.path.abspath(sys.argv[sys.argv.index("--screenshots") + 1])
+    exe = chromium()
+    if exe is None:
+        print("SKIP: chromium is not installed (Debian package `chromium`, "
+              "scripts/ci-packages.sh installs it)")
+        return 77
+    os.makedirs(work, exist_ok=True)
+    reports = write_reports(cli, work)
+    failures = []
+    for name, page in reports.items():
+        failures += check(exe, name, page, work)
+        if shots:
+            os.makedirs(shots, exist_ok=True)
+            browser(exe, page, work, [f"--screenshot={os.path.join(shots, name + '.png')}"])
+    for f in failures:
+        print("FAILED:", f)
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
