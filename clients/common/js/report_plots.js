@@ -83,7 +83,9 @@
         ctx.fill();
         if (m[3]) {
           ctx.font = 'bold 11px sans-serif';
-          ctx.fillText(m[3], p[0] + 6, p[1] + 14);
+          var w = ctx.measureText(m[3]).width;
+          var left = p[0] + 6 + w > area.x + area.w ? p[0] - 6 - w : p[0] + 6;
+          ctx.fillText(m[3], left, p[1] + 14);
         }
       });
       ctx.restore();

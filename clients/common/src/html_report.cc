@@ -45,8 +45,10 @@ constexpr const char* kZuptShade = "rgba(35,139,69,0.13)";
 
 constexpr const char* kReportStyle = R"(<style>
 .headline { display: flex; flex-wrap: wrap; gap: 1.5em; align-items: flex-start; }
+.headline > div { flex: 1 1 460px; max-width: 660px; min-width: 0; }
+.setup td { max-width: 420px; }
 .answer { border: 2px solid #08519c; padding: 6px 12px; margin: 8px 0; }
-.answer .big { font-size: 1.3em; font-weight: bold; }
+.answer .big { font-size: 1.15em; font-weight: bold; }
 table.facts th { text-align: left; font-weight: normal; color: #555; }
 table.facts td { text-align: left; }
 td.num { font-family: monospace; }
@@ -281,14 +283,21 @@ std::string TrajectoryPlot(const Scenario& scenario) {
   p.y_label = "north of start [m]";
   p.points_only = true;
   p.equal_axes = true;
-  p.width_px = 380;
-  p.height_px = 330;
+  p.width_px = 440;
+  p.height_px = 360;
   plot::Series track{"truth", kMeanColor, {}, {}, {}, {}, 1.5};
   for (const size_t i : order) {
     p.x.push_back(scenario.east_m[i]);
     track.y.push_back(scenario.north_m[i]);
   }
   p.series.push_back(track);
+  // Axes fit the track with a 5 % margin (equal scales widen the shorter one).
+  const auto [east_lo, east_hi] = std::minmax_element(scenario.east_m.begin(), scenario.east_m.end());
+  const auto [north_lo, north_hi] =
+      std::minmax_element(scenario.north_m.begin(), scenario.north_m.end());
+  const double pad = 0.05 * std::max({*east_hi - *east_lo, *north_hi - *north_lo, 1.0});
+  p.x_range = {*east_lo - pad, *east_hi + pad};
+  p.y_range = {*north_lo - pad, *north_hi + pad};
   p.markers.push_back({scenario.east_m.front(), scenario.north_m.front(), kCep50Color, "start"});
   p.markers.push_back({scenario.east_m.back(), scenario.north_m.back(), kRmsColor, "end"});
   return plot::Figure(p, fmt::format("true trajectory, north against east of the start (equal "
@@ -326,13 +335,20 @@ std::string HeadlineBox(const v1::JobResult& result) {
   std::string html = fmt::format(
       "<div class=\"answer\"><div class=\"big\">After {} s: CEP50 {}, CEP95 {}</div>\n",
       Num(epoch.t_s()), cep(checkpoint.cep50_m(), 0.5), cep(checkpoint.cep95_m(), 0.95));
-  html += "<table><tr><th>final &sigma; (over the runs)</th><th>value</th><th>95 % interval</th></tr>\n";
-  for (const int c : {0, 1, 2, 3, 4, 5, 6, 7, 8}) {
-    const v1::ComponentStatistics& s = epoch.components(c);
-    const RowFormat f{s.std(), s.std_ci95_low(), s.std_ci95_high()};
-    html += fmt::format("<tr><td>{}</td><td class=\"num\">{} {}</td><td class=\"num\">[{}, {}]</td></tr>\n",
-                        kComponentNames[c], f(s.std()), ComponentUnit(Component(c)),
-                        f(s.std_ci95_low()), f(s.std_ci95_high()));
+  // Final sigma over the runs with its 95 % interval, a 3 x 3 block: position, velocity and
+  // attitude by axis (north/east/down; roll/pitch/yaw).
+  html += "<table><tr><th>final &sigma; (95 % interval)</th><th>north / roll</th>"
+          "<th>east / pitch</th><th>down / yaw</th></tr>\n";
+  constexpr const char* kGroups[3] = {"position", "velocity", "attitude"};
+  for (int g = 0; g < 3; ++g) {
+    html += fmt::format("<tr><td>{} [{}]</td>", kGroups[g], ComponentUnit(Component(3 * g)));
+    for (int axis = 0; axis < 3; ++axis) {
+      const v1::ComponentStatistics& s = epoch.components(3 * g + axis);
+      const RowFormat f{s.std(), s.std_ci95_low(), s.std_ci95_high()};
+      html += fmt::format("<td class=\"num\">{} <small>[{}, {}]</small></td>", f(s.std()),
+                          f(s.std_ci95_low()), f(s.std_ci95_high()));
+    }
+    html += "</tr>\n";
   }
   html += fmt::format("</table><small>{} runs; CEP intervals from the order statistics of the "
                       "runs' horizontal errors</small></div>\n",
@@ -659,13 +675,18 @@ std::string RenderHtmlReport(const v1::JobResult& result) {
   html += "<h1>driftlab Monte-Carlo report: " + EscapeHtml(name) + "</h1>\n";
   if (!job.description().empty()) html += "<p>" + EscapeHtml(job.description()) + "</p>\n";
   const Scenario scenario = RegenerateScenario(result);
-  html += "<div class=\"headline\">\n<div>" + SetupTable(result, scenario) + "</div>\n<div>" +
-          TrajectoryPlot(scenario) + "</div>\n<div>" + HeadlineBox(result) +
+  html += "<div class=\"headline\">\n<div class=\"setup\">" + HeadlineBox(result) +
+          SetupTable(result, scenario) + "</div>\n<div>" + TrajectoryPlot(scenario) +
           ConsistencyBox(result) + "</div>\n</div>\n";
 
   html += "<h2>Summary</h2>\n" + SummaryTable(result);
-  for (int i = 0; i + 1 < result.checkpoints_size(); ++i) {
-    html += CheckpointTable(result.checkpoints(i));
+  if (result.checkpoints_size() > 1) {
+    html += fmt::format("<details><summary>Percentiles at the {} earlier checkpoints</summary>\n",
+                        result.checkpoints_size() - 1);
+    for (int i = 0; i + 1 < result.checkpoints_size(); ++i) {
+      html += CheckpointTable(result.checkpoints(i));
+    }
+    html += "</details>\n";
   }
 
   html += fmt::format(
