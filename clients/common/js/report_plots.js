@@ -27,6 +27,19 @@
     if (ctx.setLineDash) ctx.setLineDash(d || []);
   }
 
+  // Data -> canvas coordinates on linear or log axes (dygraphs' toDomXCoord maps x linearly even
+  // on a log x axis).
+  function domX(g, x) {
+    if (!g.getOptionForAxis('logscale', 'x')) return g.toDomXCoord(x);
+    var r = g.xAxisRange(), a = g.getArea();
+    var l0 = Math.log(r[0]), l1 = Math.log(r[1]);
+    return a.x + (Math.log(x) - l0) / (l1 - l0) * a.w;
+  }
+
+  function dom(g, x, y) {
+    return [domX(g, x), g.toDomYCoord(y)];
+  }
+
   // Shaded x intervals, circles, vertical lines, line segments (slope guides) and labelled
   // markers, in data coordinates, under the series.
   function underlay(spec) {
@@ -36,12 +49,12 @@
       ctx.rect(area.x, area.y, area.w, area.h);
       ctx.clip();
       (spec.shades || []).forEach(function (s) {
-        var a = g.toDomXCoord(s[0]), b = g.toDomXCoord(s[1]);
+        var a = domX(g, s[0]), b = domX(g, s[1]);
         ctx.fillStyle = s[2];
         ctx.fillRect(a, area.y, Math.max(1, b - a), area.h);
       });
       (spec.vlines || []).forEach(function (v) {
-        var x = g.toDomXCoord(v[0]);
+        var x = domX(g, v[0]);
         ctx.strokeStyle = v[1];
         ctx.lineWidth = 2;
         ctx.beginPath();
@@ -50,8 +63,8 @@
         ctx.stroke();
       });
       (spec.circles || []).forEach(function (c) {
-        var p = g.toDomCoords(c[0], c[1]);
-        var rx = Math.abs(g.toDomXCoord(c[0] + c[2]) - p[0]);
+        var p = dom(g, c[0], c[1]);
+        var rx = Math.abs(domX(g, c[0] + c[2]) - p[0]);
         var ry = Math.abs(g.toDomYCoord(c[1] + c[2]) - p[1]);
         ctx.strokeStyle = c[3];
         ctx.lineWidth = 2;
@@ -60,7 +73,7 @@
         ctx.stroke();
       });
       (spec.segments || []).forEach(function (s) {
-        var a = g.toDomCoords(s[0], s[1]), b = g.toDomCoords(s[2], s[3]);
+        var a = dom(g, s[0], s[1]), b = dom(g, s[2], s[3]);
         ctx.strokeStyle = s[4];
         ctx.lineWidth = 1;
         dash(ctx, [2, 3]);
@@ -72,11 +85,11 @@
         if (s[5]) {
           ctx.fillStyle = s[4];
           ctx.font = '11px sans-serif';
-          ctx.fillText(s[5], b[0] + 3, b[1] - 3);
+          ctx.fillText(s[5], (a[0] + b[0]) / 2 + 4, (a[1] + b[1]) / 2 - 4);
         }
       });
       (spec.markers || []).forEach(function (m) {
-        var p = g.toDomCoords(m[0], m[1]);
+        var p = dom(g, m[0], m[1]);
         ctx.fillStyle = m[2];
         ctx.beginPath();
         ctx.arc(p[0], p[1], 4, 0, 2 * Math.PI);
@@ -156,7 +169,7 @@
         var row = spec.data[i];
         for (var s = 1; s < row.length; ++s) {
           if (row[s] === null) continue;
-          var p = g.toDomCoords(row[0], row[s]);
+          var p = dom(g, row[0], row[s]);
           var d2 = (p[0] - x) * (p[0] - x) + (p[1] - y) * (p[1] - y);
           if (d2 < best_d2) {
             best_d2 = d2;

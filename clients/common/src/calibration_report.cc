@@ -10,6 +10,7 @@
 
 #include "driftlab/units.h"
 #include "driftlab/v1/job.pb.h"
+#include "interactive_plot.h"
 #include "svg_plot.h"
 
 namespace driftlab::jobspec {
@@ -36,7 +37,8 @@ ul.messages { font-size: 0.9em; }
 
 std::string Head(const std::string& title) {
   return "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\"/>\n<title>" +
-         EscapeHtml(title) + "</title>\n" + svg::kStyle + kExtraStyle + "</head>\n<body>\n";
+         EscapeHtml(title) + "</title>\n" + svg::kStyle + kExtraStyle + plot::PlotLibrary() +
+         "</head>\n<body>\n";
 }
 
 std::string Full(double v) { return fmt::format("{:.17g}", v); }
@@ -184,28 +186,90 @@ std::string TermsTable(const v1::NoiseModelFit& fit) {
   return out + "</table>\n";
 }
 
-std::string AllanPlot(const v1::AllanCurve& curve) {
-  Range x, y;
-  Points adev, fitted;
-  for (int i = 0; i < curve.tau_s_size(); ++i) {
-    x.Add(curve.tau_s(i));
-    for (double v : {curve.adev(i), curve.adev_lower(i), curve.adev_upper(i), curve.adev_fit(i)}) {
-      if (v > 0) y.Add(v);
+// The unit the terms table uses for a curve's ADEV: deg/h for rates, ug for specific force
+// (issue 20: the plots in rad/s and m/s^2 did not match the table); other units unchanged.
+std::string PlotUnit(const std::string& si_unit) {
+  if (si_unit == "rad/s") return "deg/h";
+  if (si_unit == "m/s^2") return "ug";
+  return si_unit;
+}
+
+double ScaleTo(const std::string& unit, const std::string& si_unit) {
+  if (unit == si_unit) return 1.0;
+  try {
+    return FromSi(1.0, unit);
+  } catch (const std::exception&) {
+    return 1.0;
+  }
+}
+
+// Log-log ADEV plot in the table's units with the -1/2, 0 and +1/2 slope guides and the read-off
+// points of the kept terms (IEEE Std 952-1997 Annex C, C.1-C.5): N is the -1/2 line at tau = 1 s,
+// K the +1/2 line at tau = 3 s, Q the -1 line at tau = sqrt(3) s, R the +1 line at tau = sqrt(2) s,
+// B the flat floor at 0.664 B (sqrt(2 ln 2 / pi) B) where the fitted curve is lowest.
+std::string AllanPlot(const v1::AllanCurve& curve, const std::vector<const v1::NoiseTerm*>& terms) {
+  const std::string unit = PlotUnit(curve.unit());
+  const double k = ScaleTo(unit, curve.unit());
+  plot::Plot p;
+  p.name = "allan-" + curve.column();
+  p.x_label = "tau [s]";
+  p.y_label = "Allan deviation [" + unit + "]";
+  p.log_x = p.log_y = true;
+  p.width_px = 520;
+  p.height_px = 360;
+  plot::Series adev{"ADEV, 95 % CI", kAdevColor, {}, {}, {}, {}, 1.5};
+  plot::Series fitted{"fitted model", kFitColor, {}, {}, {}, {6, 3}, 1.5};
+  const int n = curve.tau_s_size();
+  double min_fit = INFINITY, tau_min_fit = NAN;
+  for (int i = 0; i < n; ++i) {
+    p.x.push_back(curve.tau_s(i));
+    adev.y.push_back(k * curve.adev(i));
+    adev.lo.push_back(k * curve.adev_lower(i));
+    adev.hi.push_back(k * curve.adev_upper(i));
+    fitted.y.push_back(k * curve.adev_fit(i));
+    if (curve.adev_fit(i) > 0 && curve.adev_fit(i) < min_fit) {
+      min_fit = curve.adev_fit(i);
+      tau_min_fit = curve.tau_s(i);
     }
-    adev.emplace_back(curve.tau_s(i), curve.adev(i));
-    fitted.emplace_back(curve.tau_s(i), curve.adev_fit(i));
   }
-  Chart chart(560, 380, x, y, "tau [s]", "Allan deviation [" + curve.unit() + "]",
-              svg::Scale::kLog10, svg::Scale::kLog10);
-  for (int i = 0; i < curve.tau_s_size(); ++i) {
-    chart.ErrorBar(curve.tau_s(i), curve.adev_lower(i), curve.adev_upper(i), kAdevColor);
+  p.series = {adev, fitted};
+  if (n >= 2 && curve.adev(0) > 0 && curve.adev(n - 1) > 0) {
+    const double t0 = curve.tau_s(0), t1 = curve.tau_s(n - 1);
+    const double y0 = k * curve.adev(0), y1 = k * curve.adev(n - 1);
+    // Guides: -1/2 through the first point, +1/2 through the last, 0 at the fitted minimum; the
+    // sloped ones end where they leave the data's range (y_lo), so their labels stay visible.
+    double y_lo = INFINITY;
+    for (int i = 0; i < n; ++i) {
+      if (curve.adev_lower(i) > 0) y_lo = std::min(y_lo, k * curve.adev_lower(i));
+    }
+    if (!std::isfinite(y_lo)) y_lo = std::min(y0, y1);
+    const double t_minus = std::min(t1, t0 * (y0 / y_lo) * (y0 / y_lo));
+    const double t_plus = std::max(t0, t1 * (y_lo / y1) * (y_lo / y1));
+    p.segments.push_back({t0, y0, t_minus, y0 * std::sqrt(t0 / t_minus), "#777777", "-1/2"});
+    p.segments.push_back({t_plus, y1 * std::sqrt(t_plus / t1), t1, y1, "#777777", "+1/2"});
+    if (std::isfinite(tau_min_fit)) {
+      p.segments.push_back({t0, k * min_fit, t1, k * min_fit, "#777777", "0"});
+    }
   }
-  chart.Polyline(adev, kAdevColor);
-  chart.Polyline(fitted, kFitColor, "stroke-dasharray=\"6,3\"");
-  chart.Legend(
-      {{kAdevColor, "", "overlapping ADEV, 95 % CI"}, {kFitColor, "6,3", "fitted model (triad)"}});
-  return Figure(chart.Finish(),
-                fmt::format("{}: {} taus, log-log", curve.column(), curve.tau_s_size()));
+  for (const v1::NoiseTerm* t : terms) {
+    if (!t->determined() || !(t->value() > 0)) continue;
+    const std::string value = InDatasheetUnits(t->value(), DatasheetUnit(*t));
+    if (t->name() == "white_noise") {
+      p.markers.push_back({1.0, k * t->value(), kFitColor, "N = " + value});
+    } else if (t->name() == "random_walk") {
+      p.markers.push_back({3.0, k * t->value(), kFitColor, "K = " + value});
+    } else if (t->name() == "quantization") {
+      p.markers.push_back({std::sqrt(3.0), k * t->value(), kFitColor, "Q = " + value});
+    } else if (t->name() == "rate_ramp") {
+      p.markers.push_back({std::sqrt(2.0), k * t->value(), kFitColor, "R = " + value});
+    } else if (t->name() == "bias_instability" && std::isfinite(tau_min_fit)) {
+      p.markers.push_back({tau_min_fit, k * 0.6643 * t->value(), kFitColor, "B = " + value});
+    }
+  }
+  return plot::Figure(p, fmt::format("{}: {} taus; guides of slope -1/2 (white noise), 0 (bias "
+                                     "instability), +1/2 (random walk); dots: read-off points of "
+                                     "the kept terms",
+                                     curve.column(), n));
 }
 
 std::string SensorJson(const v1::NoiseModelFit& fit) {
@@ -249,7 +313,13 @@ std::string RenderNoiseFitReport(const v1::NoiseModelFit& fit, const std::string
       "<tr><th>fit time</th><td>{} s</td></tr>\n</table>\n",
       fit.curves_size(), Num(fit.fit_time_s()));
   html += "<h2>Allan deviation and fitted model</h2>\n<div class=\"grid\">\n";
-  for (const v1::AllanCurve& curve : fit.curves()) html += AllanPlot(curve);
+  for (const v1::AllanCurve& curve : fit.curves()) {
+    std::vector<const v1::NoiseTerm*> terms;
+    for (const v1::NoiseTerm& t : fit.terms()) {
+      if (t.axis() == curve.column()) terms.push_back(&t);
+    }
+    html += AllanPlot(curve, terms);
+  }
   html += "</div>\n<h2>Fitted terms</h2>\n" + TermsTable(fit);
   html += "<h2>Fit tables</h2>\n";
   for (const std::string& m : fit.messages()) {
