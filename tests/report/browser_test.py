@@ -6,7 +6,7 @@ Usage: browser_test.py DRIFTLAB_CLI WORK_DIR [--screenshots DIR]
 
 Report types: the Monte-Carlo report (`driftlab run --report`, examples/car_drive_gnss.json cut to
 20 runs: GNSS outage and ZUPT shading, NEES plot, scatter), the calibration report
-(`driftlab calibrate imu --report`, on tests/data/calib_imu_sample.csv) and the noise-fit report
+(`driftlab calibrate imu --report` on a tumble written here) and the noise-fit report
 (`driftlab export` of a static recording, then `driftlab allan --fit --report`).
 
 Each page is loaded with `chromium --headless --disable-gpu --no-sandbox --dump-dom` after a
@@ -50,6 +50,61 @@ def browser(exe, page, work, extra):
     return subprocess.run(cmd, cwd=work, capture_output=True, text=True, timeout=120)
 
 
+def rotation(axis, angle):
+    """Rotation matrix about body axis 0, 1, 2 by angle [rad] (frame rotation of a vector)."""
+    import math
+    c, s = math.cos(angle), math.sin(angle)
+    i, j = [(1, 2), (2, 0), (0, 1)][axis]
+    m = [[1.0 if r == k else 0.0 for k in range(3)] for r in range(3)]
+    m[i][i], m[i][j], m[j][i], m[j][j] = c, -s, s, c
+    return m
+
+
+def matmul(a, b):
+    return [[sum(a[r][k] * b[k][c] for k in range(3)) for c in range(3)] for r in range(3)]
+
+
+def write_tumble(path):
+    """A 19-pose tumble at 100 Hz (t_s, gx, gy, gz [rad/s], ax, ay, az [m/s^2]): 30 s initial
+    pose, then 1 s rotations about a horizontal body axis (90 to 150 deg) and 5 s poses; gravity
+    9.806198 m/s^2 (--lat 45), accelerometer scale errors (+500, -300, +200 ppm) and biases
+    (0.02, -0.03, 0.01 m/s^2), white noise from a fixed seed."""
+    import random
+    import math
+    rng = random.Random(20)
+    rate, g = 100.0, 9.806198  # WGS-84 normal gravity at 45 deg, 0 m
+    scale, bias = [5e-4, -3e-4, 2e-4], [0.02, -0.03, 0.01]
+    C_b_n = [[1.0, 0, 0], [0, 1.0, 0], [0, 0, 1.0]]
+    rows, t = [], 0.0
+
+    def emit(omega):
+        nonlocal t
+        up = [-C_b_n[2][k] * g for k in range(3)]  # f_b = C_b_n^T (0, 0, -g)
+        f = [(1 + scale[k]) * up[k] + bias[k] + rng.gauss(0, 2e-3) for k in range(3)]
+        w = [omega[k] + rng.gauss(0, 2e-4) for k in range(3)]
+        rows.append(f"{t:.2f},{w[0]:.9g},{w[1]:.9g},{w[2]:.9g},{f[0]:.9g},{f[1]:.9g},{f[2]:.9g}")
+        t += 1 / rate
+
+    for _ in range(int(30 * rate)):
+        emit([0, 0, 0])
+    for p in range(18):
+        # About one of the two body axes nearest the horizontal, in turn (a rotation about the
+        # vertical would leave the specific force unchanged and merge two poses).
+        ups = [abs(C_b_n[2][k]) for k in range(3)]
+        axis = sorted(range(3), key=lambda k: (round(ups[k], 3), k))[p % 2]
+        angle = math.radians([90, 120, 150, -100, -130][p % 5])
+        omega = [0.0, 0.0, 0.0]
+        omega[axis] = angle
+        step = rotation(axis, angle / rate)
+        for _ in range(int(rate)):
+            C_b_n = matmul(C_b_n, step)
+            emit(omega)
+        for _ in range(int(5 * rate)):
+            emit([0, 0, 0])
+    with open(path, "w") as out:
+        out.write("t_s,gx,gy,gz,ax,ay,az\n" + "\n".join(rows) + "\n")
+
+
 def write_reports(cli, work):
     reports = {}
     job = json.load(open(os.path.join(ROOT, "examples", "car_drive_gnss.json")))
@@ -60,8 +115,9 @@ def write_reports(cli, work):
          os.path.join(work, "monte_carlo.html")], work)
     reports["monte_carlo"] = os.path.join(work, "monte_carlo.html")
 
-    calib_csv = os.path.join(ROOT, "tests", "data", "calib_imu_sample.csv")
-    run([cli, "calibrate", "imu", calib_csv, "--out", os.path.join(work, "calib.json"),
+    calib_csv = os.path.join(work, "tumble.csv")
+    write_tumble(calib_csv)
+    run([cli, "calibrate", "imu", calib_csv, "--lat", "45", "--out", os.path.join(work, "calib.json"),
          "--report", os.path.join(work, "calibration.html")], work)
     reports["calibration"] = os.path.join(work, "calibration.html")
 

@@ -23,11 +23,15 @@
 
 #include <string>
 
+#include "driftlab/jobspec/calibration_job.h"
 #include "driftlab/v1/calibration.pb.h"
 
 namespace driftlab::jobspec {
 
-std::string RenderCalibrationReport(const v1::CalibrationResult& result);
+// `recording` (optional): the table the result was computed from, with `rate_hz` as in
+// CalibrateSettings (0: the table's first column is t_s); adds the raw-recording plots.
+std::string RenderCalibrationReport(const v1::CalibrationResult& result,
+                                    const NumericTable* recording = nullptr, double rate_hz = 0.0);
 
 // `data_name` titles the report (e.g. the CSV path).
 std::string RenderNoiseFitReport(const v1::NoiseModelFit& fit, const std::string& data_name);
