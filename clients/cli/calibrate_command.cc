@@ -76,7 +76,8 @@ int RunCalibrate(CalibrateOptions o) {
   }
   if (const int status = WriteOutputText(o.out_path, json, "--out")) return status;
   if (o.report_path.empty()) return kExitOk;
-  return WriteOutputText(o.report_path, jobspec::RenderCalibrationReport(result, &table, o.settings.rate_hz),
+  return WriteOutputText(o.report_path,
+                         jobspec::RenderCalibrationReport(result, &table, o.settings.rate_hz),
                          "--report");
 }
 

@@ -18,11 +18,7 @@
 namespace driftlab::jobspec {
 namespace {
 
-using svg::Chart;
-using svg::Figure;
 using svg::Num;
-using svg::Points;
-using svg::Range;
 
 // Colours of the residual series and of the Allan plots (ColorBrewer "Set1").
 constexpr const char* kSeriesColors[3] = {"#e41a1c", "#377eb8", "#4daf4a"};
@@ -31,7 +27,6 @@ constexpr const char* kAdevColor = "#08519c";
 constexpr const char* kFitColor = "#d94801";
 
 constexpr const char* kExtraStyle = R"(<style>
-svg.chart g.legend text { font-size: 10px; }
 td.num { font-family: monospace; }
 .flag { color: #b00020; font-size: 0.9em; }
 p.model { max-width: 60em; font-size: 0.9em; background: #f4f4f4; padding: 0.5em; }
@@ -136,13 +131,15 @@ SeriesLayout Layout(const v1::CalibrationFitResult& fit, size_t poses) {
   return layout;
 }
 
-std::string ResidualPlot(const v1::CalibrationFitResult& fit, size_t poses) {
+// `name`: unique in the report (a reference calibration has one fit per axis).
+std::string ResidualPlot(const v1::CalibrationFitResult& fit, size_t poses,
+                         const std::string& name) {
   const SeriesLayout layout = Layout(fit, poses);
   const int k = static_cast<int>(layout.names.size());
   const int n = fit.residuals_size() / k;
   const std::string unit = fit.residual_unit();
   plot::Plot p;
-  p.name = "residuals-" + fit.kind();
+  p.name = name;
   p.x_label = layout.x_label;
   p.y_label = "residual [" + unit + "]";
   p.width_px = 600;
@@ -153,17 +150,16 @@ std::string ResidualPlot(const v1::CalibrationFitResult& fit, size_t poses) {
     for (int i = 0; i < n; ++i) series.y.push_back(fit.residuals(i * k + s));
     p.series.push_back(series);
   }
-  plot::Series rms{"+RMS", kRmsColor, std::vector<double>(n, fit.residual_rms()), {}, {}, {5, 3},
-                   1.0};
+  plot::Series rms{"+RMS", kRmsColor, std::vector<double>(n, fit.residual_rms()), {}, {},
+                   {5, 3}, 1.0};
   plot::Series minus_rms = rms;
   minus_rms.label = "-RMS";
   for (double& v : minus_rms.y) v = -v;
   p.series.push_back(rms);
   p.series.push_back(minus_rms);
   return plot::Figure(p, fmt::format("{} fit residuals: {} per {} ({} residuals, RMS {} {})",
-                                     fit.kind(), k == 1 ? "one" : std::to_string(k),
-                                     layout.x_label, fit.residuals_size(),
-                                     Num(fit.residual_rms()), unit));
+                                     fit.kind(), k == 1 ? "one" : std::to_string(k), layout.x_label,
+                                     fit.residuals_size(), Num(fit.residual_rms()), unit));
 }
 
 // The recording against time with the detected static intervals shaded and numbered (issue 20):
@@ -190,8 +186,8 @@ std::string RecordingPlots(const NumericTable& table, double rate_hz,
     const char* axes[3] = {"x", "y", "z"};
     std::vector<plot::Series> series;
     for (int i = 0; i < 3; ++i) {
-      series.push_back({std::string(gyro ? "omega " : "f ") + axes[i], kSeriesColors[i], {}, {},
-                        {}, {}, 1.0});
+      series.push_back(
+          {std::string(gyro ? "omega " : "f ") + axes[i], kSeriesColors[i], {}, {}, {}, {}, 1.0});
     }
     for (size_t k = 0; k < rows; k += stride) {
       const double* row = &table.values[k * columns];
@@ -204,8 +200,8 @@ std::string RecordingPlots(const NumericTable& table, double rate_hz,
       p.shades.push_back(plot::Shade{pose.t_begin_s, pose.t_end_s, shade});
       if (!gyro) {
         const double top = std::max({pose.f[0], pose.f[1], pose.f[2]});
-        p.markers.push_back({0.5 * (pose.t_begin_s + pose.t_end_s), top, "#238b45",
-                             std::to_string(pose.index)});
+        p.markers.push_back(
+            {0.5 * (pose.t_begin_s + pose.t_end_s), top, "#238b45", std::to_string(pose.index)});
       }
     }
     out += plot::Figure(
@@ -233,8 +229,8 @@ std::string PoseDirectionPlot(const std::vector<Pose>& poses) {
   p.x_range = {-185, 185};
   p.y_range = {-95, 95};
   for (const Pose& pose : poses) {
-    const double norm = std::sqrt(pose.f[0] * pose.f[0] + pose.f[1] * pose.f[1] +
-                                  pose.f[2] * pose.f[2]);
+    const double norm =
+        std::sqrt(pose.f[0] * pose.f[0] + pose.f[1] * pose.f[1] + pose.f[2] * pose.f[2]);
     if (!(norm > 0)) continue;
     const double az = std::atan2(pose.f[1], pose.f[0]) * 180.0 / M_PI;
     const double el = std::asin(std::clamp(pose.f[2] / norm, -1.0, 1.0)) * 180.0 / M_PI;
@@ -302,16 +298,15 @@ std::string CorrelationTable(const v1::CalibrationFitResult& fit) {
     for (int j = 0; j < n; ++j) {
       const double rho = fit.correlation(i * n + j);
       const double a = std::isfinite(rho) ? std::min(1.0, std::abs(rho)) : 0.0;
-      out += fmt::format(
-          "<td class=\"num\" style=\"background:rgba({},{:.2f})\">{:.2f}</td>",
-          rho >= 0 ? "203,24,29" : "8,81,156", i == j ? 0.0 : 0.6 * a, rho);
+      out += fmt::format("<td class=\"num\" style=\"background:rgba({},{:.2f})\">{:.2f}</td>",
+                         rho >= 0 ? "203,24,29" : "8,81,156", i == j ? 0.0 : 0.6 * a, rho);
     }
     out += "</tr>\n";
   }
   return out + "</table>\n";
 }
 
-std::string FitSection(const v1::CalibrationFitResult& fit, size_t poses) {
+std::string FitSection(const v1::CalibrationFitResult& fit, size_t poses, int index) {
   std::string out = "<h2>" + EscapeHtml(fit.kind()) + " fit</h2>\n";
   out += fmt::format(
       "<table class=\"facts\">\n<tr><th>poses / rotations / rows used</th><td>{}</td></tr>\n"
@@ -330,7 +325,8 @@ std::string FitSection(const v1::CalibrationFitResult& fit, size_t poses) {
     std::string datasheet = "-";
     if (!unit.empty()) {
       try {
-        datasheet = FormatQuantity(p.value(), unit, 4) + " +- " + FormatQuantity(p.sigma(), unit, 2);
+        datasheet =
+            FormatQuantity(p.value(), unit, 4) + " +- " + FormatQuantity(p.sigma(), unit, 2);
       } catch (const std::exception&) {
       }
     }
@@ -345,7 +341,12 @@ std::string FitSection(const v1::CalibrationFitResult& fit, size_t poses) {
   }
   out += "</table>\n";
   out += CorrelationTable(fit);
-  if (fit.residuals_size() > 0) out += ResidualPlot(fit, poses);
+  if (fit.residuals_size() > 0) {
+    const std::string name = fit.kind() == "reference"
+                                 ? fmt::format("residuals-reference-{}", index + 1)
+                                 : "residuals-" + fit.kind();
+    out += ResidualPlot(fit, poses, name);
+  }
   out += MessageList(fit.messages());
   return out;
 }
@@ -525,9 +526,10 @@ std::string RenderCalibrationReport(const v1::CalibrationResult& result,
     if (result.messages_size() > 1) {
       google::protobuf::RepeatedPtrField<std::string> rest(result.messages().begin() + 1,
                                                            result.messages().end());
-      html += fmt::format("<details><summary>{} more lines (the poses, numbered as in the "
-                          "plots)</summary>\n{}</details>\n",
-                          rest.size(), MessageList(rest));
+      html += fmt::format(
+          "<details><summary>{} more lines (the poses, numbered as in the "
+          "plots)</summary>\n{}</details>\n",
+          rest.size(), MessageList(rest));
     }
   }
   const std::vector<Pose> poses = PosesOf(result);
@@ -536,7 +538,9 @@ std::string RenderCalibrationReport(const v1::CalibrationResult& result,
     if (recording != nullptr) html += RecordingPlots(*recording, rate_hz, poses);
     html += PoseDirectionPlot(poses) + "</div>\n";
   }
-  for (const v1::CalibrationFitResult& fit : result.fits()) html += FitSection(fit, poses.size());
+  for (int i = 0; i < result.fits_size(); ++i) {
+    html += FitSection(result.fits(i), poses.size(), i);
+  }
   return html + "</body>\n</html>\n";
 }
 

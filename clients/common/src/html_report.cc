@@ -58,10 +58,17 @@ details { margin: 1em 0; } summary { cursor: pointer; font-weight: bold; }
 
 v1::ErrorComponent Component(int c) { return static_cast<v1::ErrorComponent>(c + 1); }
 
-constexpr const char* kComponentNames[kErrorComponentCount] = {
-    "north position", "east position", "down position", "north velocity",
-    "east velocity",  "down velocity", "roll",          "pitch",
-    "yaw",            "horizontal position", "3-D position"};
+constexpr const char* kComponentNames[kErrorComponentCount] = {"north position",
+                                                               "east position",
+                                                               "down position",
+                                                               "north velocity",
+                                                               "east velocity",
+                                                               "down velocity",
+                                                               "roll",
+                                                               "pitch",
+                                                               "yaw",
+                                                               "horizontal position",
+                                                               "3-D position"};
 
 // "north position error [m]" for axis labels and headings.
 std::string ComponentLabel(int c) {
@@ -79,8 +86,8 @@ class RowFormat {
     for (const double v : values) {
       if (std::isfinite(v)) largest = std::max(largest, std::abs(v));
     }
-    decimals_ = largest > 0 ? std::clamp(3 - static_cast<int>(std::floor(std::log10(largest))), 0, 9)
-                            : 0;
+    decimals_ =
+        largest > 0 ? std::clamp(3 - static_cast<int>(std::floor(std::log10(largest))), 0, 9) : 0;
   }
   std::string operator()(double v) const {
     if (!std::isfinite(v)) return "-";
@@ -196,10 +203,9 @@ std::string AidingText(const v1::Job& job) {
   std::vector<std::string> parts;
   const v1::Aiding& a = job.aiding();
   if (a.has_gnss()) {
-    parts.push_back(fmt::format("GNSS at {} Hz{}", Num(a.gnss().has_rate_hz() ? a.gnss().rate_hz() : 1.0),
-                                a.gnss().outages().empty()
-                                    ? ""
-                                    : fmt::format(", {} outage(s)", a.gnss().outages_size())));
+    parts.push_back(fmt::format(
+        "GNSS at {} Hz{}", Num(a.gnss().has_rate_hz() ? a.gnss().rate_hz() : 1.0),
+        a.gnss().outages().empty() ? "" : fmt::format(", {} outage(s)", a.gnss().outages_size())));
   }
   if (a.has_barometer()) parts.push_back("barometer");
   if (a.has_magnetometer()) parts.push_back("magnetometer");
@@ -234,11 +240,11 @@ std::string SetupTable(const v1::JobResult& result, const Scenario& scenario) {
   } catch (const std::exception& e) {
     rows += Fact("IMU model", e.what());
   }
-  rows += Fact("mechanization", v1::Navigation::Mechanization_Name(
-                                    job.navigation().mechanization() ==
-                                            v1::Navigation::MECHANIZATION_UNSPECIFIED
-                                        ? v1::Navigation::NED
-                                        : job.navigation().mechanization()));
+  rows += Fact("mechanization",
+               v1::Navigation::Mechanization_Name(job.navigation().mechanization() ==
+                                                          v1::Navigation::MECHANIZATION_UNSPECIFIED
+                                                      ? v1::Navigation::NED
+                                                      : job.navigation().mechanization()));
   rows += Fact("aiding", AidingText(job));
   rows += Fact("filter", job.navigation().filter() == v1::Navigation::FILTER_UNSPECIFIED
                              ? "NONE (free inertial)"
@@ -269,7 +275,8 @@ std::string ShadeKey(const Scenario& scenario) {
 }
 
 std::string TrajectoryPlot(const Scenario& scenario) {
-  if (!scenario.regenerated) return "<p>No trajectory plot: " + EscapeHtml(scenario.note) + ".</p>\n";
+  if (!scenario.regenerated)
+    return "<p>No trajectory plot: " + EscapeHtml(scenario.note) + ".</p>\n";
   // dygraphs needs ascending x: the track is drawn as north against east only when east is
   // monotonic; in general each point is one row (x = east) of a points-only series, so a track
   // that turns back is still drawn as its points.
@@ -292,7 +299,8 @@ std::string TrajectoryPlot(const Scenario& scenario) {
   }
   p.series.push_back(track);
   // Axes fit the track with a 5 % margin (equal scales widen the shorter one).
-  const auto [east_lo, east_hi] = std::minmax_element(scenario.east_m.begin(), scenario.east_m.end());
+  const auto [east_lo, east_hi] =
+      std::minmax_element(scenario.east_m.begin(), scenario.east_m.end());
   const auto [north_lo, north_hi] =
       std::minmax_element(scenario.north_m.begin(), scenario.north_m.end());
   const double pad = 0.05 * std::max({*east_hi - *east_lo, *north_hi - *north_lo, 1.0});
@@ -328,17 +336,18 @@ std::string HeadlineBox(const v1::JobResult& result) {
   for (const v1::RunValues& run : checkpoint.runs()) horizontal.push_back(run.values(kHorizontal));
   const auto cep = [&](double value, double p) {
     const auto [lo, hi] = QuantileInterval(horizontal, p);
-    return std::isfinite(lo) ? fmt::format("{} m <small>(95 %: {} - {})</small>", Num(value),
-                                           Num(lo), Num(hi))
-                             : fmt::format("{} m", Num(value));
+    return std::isfinite(lo)
+               ? fmt::format("{} m <small>(95 %: {} - {})</small>", Num(value), Num(lo), Num(hi))
+               : fmt::format("{} m", Num(value));
   };
   std::string html = fmt::format(
       "<div class=\"answer\"><div class=\"big\">After {} s: CEP50 {}, CEP95 {}</div>\n",
       Num(epoch.t_s()), cep(checkpoint.cep50_m(), 0.5), cep(checkpoint.cep95_m(), 0.95));
   // Final sigma over the runs with its 95 % interval, a 3 x 3 block: position, velocity and
   // attitude by axis (north/east/down; roll/pitch/yaw).
-  html += "<table><tr><th>final &sigma; (95 % interval)</th><th>north / roll</th>"
-          "<th>east / pitch</th><th>down / yaw</th></tr>\n";
+  html +=
+      "<table><tr><th>final &sigma; (95 % interval)</th><th>north / roll</th>"
+      "<th>east / pitch</th><th>down / yaw</th></tr>\n";
   constexpr const char* kGroups[3] = {"position", "velocity", "attitude"};
   for (int g = 0; g < 3; ++g) {
     html += fmt::format("<tr><td>{} [{}]</td>", kGroups[g], ComponentUnit(Component(3 * g)));
@@ -350,9 +359,10 @@ std::string HeadlineBox(const v1::JobResult& result) {
     }
     html += "</tr>\n";
   }
-  html += fmt::format("</table><small>{} runs; CEP intervals from the order statistics of the "
-                      "runs' horizontal errors</small></div>\n",
-                      result.run_count());
+  html += fmt::format(
+      "</table><small>{} runs; CEP intervals from the order statistics of the "
+      "runs' horizontal errors</small></div>\n",
+      result.run_count());
   return html;
 }
 
@@ -401,13 +411,15 @@ std::string ConsistencyBox(const v1::JobResult& result) {
       v.consistent() ? "#2a7d2a" : "#b00020", v.consistent() ? "consistent" : "INCONSISTENT",
       EscapeHtml(v.Summary()));
   if (!v.components.empty()) {
-    html += "<table><tr><th>component</th><th>MC &sigma; / predicted &sigma;</th><th>interval "
-            "(Bonferroni)</th><th></th></tr>\n";
+    html +=
+        "<table><tr><th>component</th><th>MC &sigma; / predicted &sigma;</th><th>interval "
+        "(Bonferroni)</th><th></th></tr>\n";
     for (const ComponentConsistency& c : v.components) {
-      html += fmt::format("<tr><td>{}</td><td class=\"num\">{:.3f}</td><td class=\"num\">[{:.3f}, "
-                          "{:.3f}]</td><td>{}</td></tr>\n",
-                          ConsistencyComponentName(c.component), c.ratio.ratio, c.ratio.low,
-                          c.ratio.high, c.flagged ? "&#9888; outside" : "ok");
+      html += fmt::format(
+          "<tr><td>{}</td><td class=\"num\">{:.3f}</td><td class=\"num\">[{:.3f}, "
+          "{:.3f}]</td><td>{}</td></tr>\n",
+          ConsistencyComponentName(c.component), c.ratio.ratio, c.ratio.low, c.ratio.high,
+          c.flagged ? "&#9888; outside" : "ok");
     }
     html += "</table>";
   }
@@ -433,8 +445,13 @@ std::string EnvelopePlot(const v1::JobResult& result, int c, const Scenario& sce
   plot::Series band{"mean ± σ", kMeanColor, {}, {}, {}, {}, 1.5};
   plot::Series rms{"RMS", kRmsColor, {}, {}, {}, {5, 3}, 1.5};
   plot::Series minus_rms{"−RMS", kRmsColor, {}, {}, {}, {5, 3}, 1.5};
-  plot::Series pred_hi{IsDistance(c) ? "predicted RMS" : "mean + predicted σ", kPredictedColor,
-                       {}, {}, {}, {1, 2}, 1.5};
+  plot::Series pred_hi{IsDistance(c) ? "predicted RMS" : "mean + predicted σ",
+                       kPredictedColor,
+                       {},
+                       {},
+                       {},
+                       {1, 2},
+                       1.5};
   plot::Series pred_lo{"mean − predicted σ", kPredictedColor, {}, {}, {}, {1, 2}, 1.5};
   for (int i = 0; i < n; ++i) {
     if (i % stride != 0 && i != n - 1) continue;
@@ -471,8 +488,8 @@ std::string EnvelopePlot(const v1::JobResult& result, int c, const Scenario& sce
 // Freedman & Diaconis would need quartiles for little gain in a report). `marks` are vertical
 // lines (value, color).
 std::string Histogram(const std::string& name, const std::vector<double>& values,
-                      const std::string& x_label, const std::string& caption, int width,
-                      int height, const std::vector<std::pair<double, const char*>>& marks) {
+                      const std::string& x_label, const std::string& caption, int width, int height,
+                      const std::vector<std::pair<double, const char*>>& marks) {
   double lo = INFINITY, hi = -INFINITY;
   for (const double v : values) {
     if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
@@ -531,11 +548,11 @@ std::string ScatterPlot(const v1::Checkpoint& checkpoint) {
     p.x.push_back(run.values(kEast));
     runs.y.push_back(run.values(kNorth));
     extent = std::max({extent, std::abs(run.values(kEast)), std::abs(run.values(kNorth))});
-    p.info.push_back(fmt::format(
-        "run {0}: east {1} m, north {2} m, horizontal {3} m\n"
-        "driftlab simulate job.json --run {0} --out run-{0}",
-        run.run_index(), Num(run.values(kEast)), Num(run.values(kNorth)),
-        Num(run.values(v1::HORIZONTAL_POSITION_M - 1))));
+    p.info.push_back(
+        fmt::format("run {0}: east {1} m, north {2} m, horizontal {3} m\n"
+                    "driftlab simulate job.json --run {0} --out run-{0}",
+                    run.run_index(), Num(run.values(kEast)), Num(run.values(kNorth)),
+                    Num(run.values(v1::HORIZONTAL_POSITION_M - 1))));
   }
   if (!(extent > 0)) extent = 1;
   extent *= 1.05;
@@ -546,7 +563,8 @@ std::string ScatterPlot(const v1::Checkpoint& checkpoint) {
   p.circles.push_back({0, 0, checkpoint.cep95_m(), kCep95Color});
   std::string caption = fmt::format(
       "horizontal error at t = {} s, one dot per run (hover: its run index and the command that "
-      "regenerates it, job.json being the job echo at the end of this report); circles about the true position: CEP50 = {} m (green), CEP95 = {} m "
+      "regenerates it, job.json being the job echo at the end of this report); circles about the "
+      "true position: CEP50 = {} m (green), CEP95 = {} m "
       "(orange)",
       Num(checkpoint.t_s()), Num(checkpoint.cep50_m()), Num(checkpoint.cep95_m()));
   if (drawn < checkpoint.runs_size()) {
@@ -568,8 +586,8 @@ std::string SummaryTable(const v1::JobResult& result) {
   for (int c = 0; c < kErrorComponentCount; ++c) {
     const v1::ComponentStatistics& s = epoch.components(c);
     const v1::ComponentPercentiles& p = checkpoint.components(c);
-    const RowFormat f{s.mean(), s.std(), s.rms(), s.rms_ci95_high(), s.std_ci95_high(),
-                      p.max_abs()};
+    const RowFormat f{s.mean(),          s.std(),           s.rms(),
+                      s.rms_ci95_high(), s.std_ci95_high(), p.max_abs()};
     out += fmt::format(
         "<tr><td>{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
         "<td class=\"num\">[{}, {}]</td><td class=\"num\">{}</td><td class=\"num\">[{}, {}]</td>"

@@ -106,8 +106,8 @@ std::string Spec(const Plot& p) {
   list("shades", items);
   items.clear();
   for (const Circle& c : p.circles) {
-    items.push_back(fmt::format("[{},{},{},{}]", Number(c.cx), Number(c.cy), Number(c.r),
-                                JsonString(c.color)));
+    items.push_back(
+        fmt::format("[{},{},{},{}]", Number(c.cx), Number(c.cy), Number(c.r), JsonString(c.color)));
   }
   list("circles", items);
   items.clear();

@@ -59,8 +59,8 @@ struct Plot {
   std::vector<double> x;  // ascending (dygraphs needs sorted x)
   std::vector<Series> series;
   bool log_x = false, log_y = false;
-  bool points_only = false;  // scatter: points, no lines
-  bool equal_axes = false;   // same units per pixel on both axes
+  bool points_only = false;         // scatter: points, no lines
+  bool equal_axes = false;          // same units per pixel on both axes
   bool step = false, fill = false;  // histogram bars
   std::vector<std::string> info;    // per x: tooltip of the nearest point (scatter)
   std::vector<Shade> shades;
