@@ -3,6 +3,7 @@
 headless Chromium with no script error and every interactive plot drawn.
 
 Usage: browser_test.py DRIFTLAB_CLI WORK_DIR [--screenshots DIR]
+(--screenshots: the first screen of each report, NAME.png, and one plot alone, NAME_plot.png.)
 
 Report types: the Monte-Carlo report (`driftlab run --report`, examples/car_drive_gnss.json cut to
 20 runs: GNSS outage and ZUPT shading, NEES plot, scatter), the calibration report
@@ -122,23 +123,52 @@ def write_reports(cli, work):
     reports["calibration"] = os.path.join(work, "calibration.html")
 
     static_job = os.path.join(work, "static.json")
-    json.dump({"name": "static_stim300", "motion": {"initial": {"lat_deg": 45.0},
+    json.dump({"name": "static_stim300", "motion": {"initial": {"lat_deg": 45.0, "lon_deg": 7.0},
                "segments": [{"static": {"duration_s": 1200}}]}, "rate_hz": 100,
                "sensor": {"preset": "stim300"}}, open(static_job, "w"))
     run([cli, "export", static_job, "--out", os.path.join(work, "static_export")], work)
-    imu_csv = None
-    for dirpath, _, files in os.walk(os.path.join(work, "static_export")):
-        for f in files:
-            if f.startswith("imu") and f.endswith(".csv"):
-                imu_csv = os.path.join(dirpath, f)
-    if imu_csv is None:
-        raise SystemExit("FAILED: driftlab export wrote no imu*.csv")
-    run([cli, "allan", imu_csv, "--fit", "--report", os.path.join(work, "noise_fit.html")], work)
+    imu_csv = os.path.join(work, "static_export", "imu.csv")  # with the sensor errors
+    if not os.path.exists(imu_csv):
+        raise SystemExit("FAILED: driftlab export wrote no imu.csv")
+    run([cli, "allan", imu_csv, "--rate", "100", "--fit", "--report",
+         os.path.join(work, "noise_fit.html")], work)
     reports["noise_fit"] = os.path.join(work, "noise_fit.html")
     return reports
 
 
-def check(exe, name, page, work):
+# The plot each report's second screenshot shows alone (--screenshots).
+PLOT_SHOTS = {"monte_carlo": "plot-envelope-position_north_m",
+              "calibration": "plot-pose-directions",
+              "noise_fit": "plot-allan-f_x_m_per_s2"}
+
+
+def plot_page(page, plot_id, work):
+    """A copy of the report showing only the element plot_id, at the top left."""
+    html = open(page, encoding="utf-8").read()
+    style = ("<style>body * { visibility: hidden; } #%s, #%s * { visibility: visible; } "
+             "#%s { position: fixed; top: 0; left: 0; background: #fff; padding: 8px; }</style>"
+             % (plot_id, plot_id, plot_id))
+    out = os.path.join(work, os.path.basename(page).replace(".html", "_plot.html"))
+    with open(out, "w", encoding="utf-8") as f:
+        f.write(html.replace("</head>", style + "</head>", 1))
+    return out
+
+
+def self_test(exe, work):
+    """The checker itself: a page with a script error and a plot that is never drawn fails."""
+    page = os.path.join(work, "broken.html")
+    with open(page, "w") as f:
+        f.write('<!DOCTYPE html><html><head><script>window.addEventListener("error", function (e)'
+                ' { document.documentElement.setAttribute("data-errors", e.message); });'
+                '</script></head><body><div class="dl-plot" data-drawn="no"></div>'
+                '<script>undefinedFunction();</script></body></html>')
+    failures = check(exe, "self-test", page, work, quiet=True)
+    if len(failures) < 2:
+        return ["self-test: a broken page passed the checks: %s" % failures]
+    return []
+
+
+def check(exe, name, page, work, quiet=False):
     html = open(page, encoding="utf-8").read()
     failures = []
     expected = len(re.findall(r'class="dl-plot"', html))
@@ -163,7 +193,8 @@ def check(exe, name, page, work):
         if "CONSOLE" in line and ("Uncaught" in line or "ERROR" in line.split("CONSOLE")[0]
                                   or "Error" in line):
             failures.append(f"{name}: console: {line}")
-    print(f"{name}: {drawn}/{expected} plots drawn, {len(html)} bytes")
+    if not quiet:
+        print(f"{name}: {drawn}/{expected} plots drawn, {len(html)} bytes")
     return failures
 
 
@@ -180,13 +211,15 @@ def main():
               "scripts/ci-packages.sh installs it)")
         return 77
     os.makedirs(work, exist_ok=True)
+    failures = self_test(exe, work)
     reports = write_reports(cli, work)
-    failures = []
     for name, page in reports.items():
         failures += check(exe, name, page, work)
         if shots:
             os.makedirs(shots, exist_ok=True)
             browser(exe, page, work, [f"--screenshot={os.path.join(shots, name + '.png')}"])
+            browser(exe, plot_page(page, PLOT_SHOTS[name], work), work,
+                    [f"--screenshot={os.path.join(shots, name + '_plot.png')}"])
     for f in failures:
         print("FAILED:", f)
     return 1 if failures else 0

@@ -85,7 +85,13 @@
         if (s[5]) {
           ctx.fillStyle = s[4];
           ctx.font = '11px sans-serif';
-          ctx.fillText(s[5], (a[0] + b[0]) / 2 + 4, (a[1] + b[1]) / 2 - 4);
+          // At the end of a sloped segment, the start of a level one (guides meet at the right),
+          // kept inside the plot area.
+          var at = s[1] === s[3] ? a : b;
+          var w = ctx.measureText(s[5]).width;
+          var x = Math.max(Math.min(at[0] + 3, area.x + area.w - w - 2), area.x + 2);
+          var y = Math.max(Math.min(at[1] - 3, area.y + area.h - 3), area.y + 11);
+          ctx.fillText(s[5], x, y);
         }
       });
       (spec.markers || []).forEach(function (m) {
@@ -98,7 +104,8 @@
           ctx.font = 'bold 11px sans-serif';
           var w = ctx.measureText(m[3]).width;
           var left = p[0] + 6 + w > area.x + area.w ? p[0] - 6 - w : p[0] + 6;
-          ctx.fillText(m[3], left, p[1] + 14);
+          var below = p[1] + 14 < area.y + area.h - 2;
+          ctx.fillText(m[3], left, below ? p[1] + 14 : p[1] - 6);
         }
       });
       ctx.restore();
