@@ -154,6 +154,36 @@ def plot_page(page, plot_id, work):
     return out
 
 
+def hover_check(exe, page, result_json, work):
+    """Hovering the westmost scatter point shows its run index and the simulate command: the
+    page is loaded with a script that moves the mouse onto row 0 of the scatter (sorted by east
+    error) and copies the tooltip into <html data-hover>."""
+    html = open(page, encoding="utf-8").read()
+    probe = ("<script>window.addEventListener('load', function () {"
+             "var root = document.querySelector('[id^=\"plot-scatter-\"]');"
+             "var g = root.driftlabGraph, holder = root.querySelector('.dl-graph');"
+             "var p = g.toDomCoords(g.getValue(0, 0), g.getValue(0, 1));"
+             "var box = holder.getBoundingClientRect();"
+             "holder.dispatchEvent(new MouseEvent('mousemove', {clientX: box.left + p[0],"
+             " clientY: box.top + p[1], bubbles: true}));"
+             "document.documentElement.setAttribute('data-hover',"
+             " holder.querySelector('.dl-tip').textContent);});</script>")
+    out = os.path.join(work, "hover.html")
+    with open(out, "w", encoding="utf-8") as f:
+        f.write(html.replace("</body>", probe + "</body>", 1))
+    dom = browser(exe, out, work, ["--dump-dom"]).stdout
+    hover = re.search(r'data-hover="([^"]*)"', dom)
+    runs = json.load(open(result_json))["checkpoints"][-1]["runs"]
+    west = min(runs, key=lambda r: r["values"][1])  # values[1]: east position error
+    want = "driftlab simulate job.json --run %d --out run-%d" % (west.get("run_index", 0),
+                                                                  west.get("run_index", 0))
+    if not hover or want not in hover.group(1):
+        return ["monte_carlo: hovering the westmost point does not show '%s' (got %s)"
+                % (want, hover.group(1) if hover else "no tooltip")]
+    print("monte_carlo: hover shows", hover.group(1).replace("\n", " | "))
+    return []
+
+
 def self_test(exe, work):
     """The checker itself: a page with a script error and a plot that is never drawn fails."""
     page = os.path.join(work, "broken.html")
@@ -213,6 +243,7 @@ def main():
     os.makedirs(work, exist_ok=True)
     failures = self_test(exe, work)
     reports = write_reports(cli, work)
+    failures += hover_check(exe, reports["monte_carlo"], os.path.join(work, "mc.json"), work)
     for name, page in reports.items():
         failures += check(exe, name, page, work)
         if shots:
