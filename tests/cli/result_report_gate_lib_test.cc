@@ -703,7 +703,7 @@ TEST(Report, IsOneSelfContainedFileWithAnInteractivePlotEach) {
   EXPECT_NE(html.find("Dygraph"), std::string::npos);
   // 11 envelopes, the scatter, the horizontal histogram and 10 other histograms.
   EXPECT_EQ(Count(html, "id=\"plot-envelope-"), 11u);
-  EXPECT_EQ(Count(html, "id=\"plot-scatter-"), 1u);
+  EXPECT_EQ(Count(html, "id=\"plot-scatter\""), 1u);
   EXPECT_EQ(Count(html, "id=\"plot-histogram-"), 11u);
   // The job name escaped everywhere (title, heading, job echo), never raw.
   EXPECT_EQ(markup.find("<b>&"), std::string::npos);
@@ -723,7 +723,7 @@ TEST(Report, IsOneSelfContainedFileWithAnInteractivePlotEach) {
   for (v1::Checkpoint& checkpoint : *no_runs.mutable_checkpoints()) checkpoint.clear_runs();
   const std::string short_html = RenderHtmlReport(no_runs);
   EXPECT_EQ(Count(short_html, "id=\"plot-envelope-"), 11u);
-  EXPECT_EQ(Count(short_html, "id=\"plot-scatter-"), 0u);
+  EXPECT_EQ(Count(short_html, "id=\"plot-scatter\""), 0u);
   EXPECT_NE(short_html.find("keeps no per-run values"), std::string::npos);
 }
 

@@ -160,7 +160,7 @@ def hover_check(exe, page, result_json, work):
     error) and copies the tooltip into <html data-hover>."""
     html = open(page, encoding="utf-8").read()
     probe = ("<script>window.addEventListener('load', function () {"
-             "var root = document.querySelector('[id^=\"plot-scatter-\"]');"
+             "var root = document.getElementById('plot-scatter');"
              "var g = root.driftlabGraph, holder = root.querySelector('.dl-graph');"
              "var p = g.toDomCoords(g.getValue(0, 0), g.getValue(0, 1));"
              "var box = holder.getBoundingClientRect();"

@@ -534,7 +534,7 @@ std::string ScatterPlot(const v1::Checkpoint& checkpoint) {
     return checkpoint.runs(a).values(kEast) < checkpoint.runs(b).values(kEast);
   });
   plot::Plot p;
-  p.name = fmt::format("scatter-{}", Num(checkpoint.t_s()));
+  p.name = "scatter";
   p.x_label = "east error [m]";
   p.y_label = "north error [m]";
   p.points_only = true;

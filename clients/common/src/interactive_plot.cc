@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <cctype>
 #include <cmath>
 
 #include "driftlab/jobspec/html_report.h"
@@ -172,7 +173,11 @@ std::string PlotLibrary() {
 }
 
 std::string Figure(const Plot& plot, const std::string& caption) {
-  const std::string id = "plot-" + plot.name;
+  // Letters, digits, '-' and '_' only: a column name from a CSV header may hold anything.
+  std::string id = "plot-" + plot.name;
+  for (char& c : id) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+  }
   return fmt::format(
       "<figure><div class=\"dl-plot\" id=\"{0}\"><div class=\"dl-toolbar\"></div>"
       "<div class=\"dl-graph\" style=\"width:{1}px;height:{2}px\"></div>"

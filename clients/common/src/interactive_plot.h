@@ -54,7 +54,8 @@ struct Marker {
 };
 
 struct Plot {
-  std::string name;  // unique in the report: element id and PNG file name
+  std::string name;  // unique in the report: element id "plot-NAME" (other characters than
+                     // letters, digits, '-' and '_' become '_') and PNG file name
   std::string x_label, y_label;
   std::vector<double> x;  // ascending (dygraphs needs sorted x)
   std::vector<Series> series;
