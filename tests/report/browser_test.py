@@ -167,7 +167,22 @@ def hover_check(exe, page, result_json, work):
              "holder.dispatchEvent(new MouseEvent('mousemove', {clientX: box.left + p[0],"
              " clientY: box.top + p[1], bubbles: true}));"
              "document.documentElement.setAttribute('data-hover',"
-             " holder.querySelector('.dl-tip').textContent);});</script>")
+             " holder.querySelector('.dl-tip').textContent);"
+             # Every toolbar control of one envelope (log x, log y, series, reset), then its PNG.
+             "var env = document.getElementById('plot-envelope-position_north_m');"
+             # Each checkbox clicked twice (both directions), then reset zoom.
+             "env.querySelectorAll('input').forEach(function (c) { c.click(); c.click(); });"
+             "env.querySelectorAll('button').forEach(function (c) {"
+             " if (c.textContent !== 'PNG') c.click(); });"
+             "var url = env.driftlabPngUrl(), box = env.querySelector('.dl-graph');"
+             "var blank = document.createElement('canvas');"
+             "blank.width = box.clientWidth * (window.devicePixelRatio || 1);"
+             "blank.height = box.clientHeight * (window.devicePixelRatio || 1);"
+             "var ctx = blank.getContext('2d'); ctx.fillStyle = '#fff';"
+             "ctx.fillRect(0, 0, blank.width, blank.height);"
+             "document.documentElement.setAttribute('data-png', url.slice(0, 22) + ' ' +"
+             " url.length + ' ' + blank.toDataURL('image/png').length);"
+             "});</script>")
     out = os.path.join(work, "hover.html")
     with open(out, "w", encoding="utf-8") as f:
         f.write(html.replace("</body>", probe + "</body>", 1))
@@ -177,11 +192,25 @@ def hover_check(exe, page, result_json, work):
     west = min(runs, key=lambda r: r["values"][1])  # values[1]: east position error
     want = "driftlab simulate job.json --run %d --out run-%d" % (west.get("run_index", 0),
                                                                   west.get("run_index", 0))
+    failures = []
     if not hover or want not in hover.group(1):
-        return ["monte_carlo: hovering the westmost point does not show '%s' (got %s)"
-                % (want, hover.group(1) if hover else "no tooltip")]
-    print("monte_carlo: hover shows", hover.group(1).replace("\n", " | "))
-    return []
+        failures.append("monte_carlo: hovering the westmost point does not show '%s' (got %s)"
+                        % (want, hover.group(1) if hover else "no tooltip"))
+    else:
+        print("monte_carlo: hover shows", hover.group(1).replace("\n", " | "))
+    # After the toggles: a PNG export at least twice the size of a blank white PNG of the same
+    # size (made in the page: lines, bands and labels do not compress to nothing), no script error.
+    png = re.search(r'data-png="data:image/png;base64, (\d+) (\d+)"', dom)
+    if not png or int(png.group(1)) < 2 * int(png.group(2)):
+        failures.append("monte_carlo: PNG export after the toolbar toggles: %s"
+                        % (png.group(0) if png else "no data URL"))
+    else:
+        print("monte_carlo: toolbar toggles done, PNG export %s characters (blank %s)"
+              % (png.group(1), png.group(2)))
+    errors = re.search(r'data-errors="([^"]*)"', dom)
+    if errors:
+        failures.append("monte_carlo: script errors after the toolbar toggles: " + errors.group(1))
+    return failures
 
 
 def self_test(exe, work):

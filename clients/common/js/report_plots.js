@@ -112,8 +112,9 @@
     };
   }
 
-  // A white PNG of the plot: the canvases and the axis labels (dygraphs draws those as HTML).
-  function exportPng(div, name) {
+  // A white PNG of the plot (data: URL): the canvases and the axis labels (dygraphs draws those
+  // as HTML).
+  function pngUrl(div) {
     var box = div.getBoundingClientRect();
     var r = window.devicePixelRatio || 1;
     var canvas = document.createElement('canvas');
@@ -140,7 +141,12 @@
       ctx.fillText(el.textContent, 0, 0);
       ctx.restore();
     });
-    var url = canvas.toDataURL('image/png');
+    return canvas.toDataURL('image/png');
+  }
+
+  // Saves pngUrl(div) as NAME.png (a download).
+  function exportPng(div, name) {
+    var url = pngUrl(div);
     var a = document.createElement('a');
     a.href = url;
     a.download = (name || 'plot') + '.png';
@@ -300,8 +306,8 @@
     });
     root.setAttribute('data-drawn', drawn(holder) ? 'yes' : 'no');
     root.driftlabGraph = g;
-    root.driftlabPng = function () {
-      return exportPng(holder, spec.name);
+    root.driftlabPngUrl = function () {
+      return pngUrl(holder);
     };
   };
 })();
