@@ -11,6 +11,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-grpcio python3-protobuf python3-matplotlib python3-numpy
   clang-format ccache
+  libjs-dygraphs
 )
 
 missing=()

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Debian packages CI's tests need beyond bootstrap.sh: slurm-wlm and munge (tests/deploy/
 # slurm_test.py starts a one-node Slurm cluster), clang-14 and libclang-rt-14-dev (libFuzzer
-# targets, fuzz/ci.sh). Non-interactive and idempotent, as bootstrap.sh.
+# targets, fuzz/ci.sh), chromium (tests/report/browser_test.py loads the HTML reports headless;
+# about 12 s to install on the development machine). Non-interactive and idempotent, as bootstrap.sh.
 set -euo pipefail
-packages=(slurm-wlm munge clang-14 libclang-rt-14-dev)
+packages=(slurm-wlm munge clang-14 libclang-rt-14-dev chromium)
 missing=()
 for p in "${packages[@]}"; do
   if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then

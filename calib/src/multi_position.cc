@@ -169,13 +169,13 @@ void SolveAndReport(ceres::Problem* problem, double* x, int n,
   double rss = 0.0;
   for (double r : residuals) rss += r * r;
   const double s2 = rss / static_cast<double>(m - n);  // residual variance
-  if (covariance != nullptr) {
-    *covariance = Eigen::Map<Eigen::MatrixXd>(cov.data(), n, n) * s2;
-  }
+  const Eigen::MatrixXd scaled = Eigen::Map<Eigen::MatrixXd>(cov.data(), n, n) * s2;
+  if (covariance != nullptr) *covariance = scaled;
   fit->parameters.clear();
   for (int i = 0; i < n; ++i) {
     fit->parameters.push_back({names[i], x[i], units[i], std::sqrt(cov[i * n + i] * s2)});
   }
+  fit->SetCorrelation(scaled);
   fit->residuals = residuals;
   fit->residual_rms = std::sqrt(rss / static_cast<double>(m));
   fit->iterations = static_cast<int>(summary.iterations.size()) - 1;
@@ -329,7 +329,7 @@ GyroCalibration CalibrateGyros(const RawImuRecording& recording,
   std::vector<std::string> units(9, "1");
   for (int i = 3; i < 9; ++i) units[i] = "rad";
   problem.SetParameterBlockConstant(bias);
-  Eigen::MatrixXd cov_x;
+  Eigen::MatrixXd cov_x, full_covariance;
   detail::SolveAndReport(&problem, x, 9, GyroParameterNames(), units, &out.fit, &cov_x);
   out.T_g = GyroMatrix(x);
   // Propagate the bias error: Cov_x += A Cov_b A^T, A = -(J_x^T J_x)^-1 J_x^T J_b.
@@ -388,6 +388,12 @@ GyroCalibration CalibrateGyros(const RawImuRecording& recording,
       cov_x += Aa * accel.covariance * Aa.transpose();
     }
     for (int i = 0; i < 9; ++i) out.fit.parameters[i].sigma = std::sqrt(cov_x(i, i));
+    // Covariance of (S, M, b_g) for the correlation matrix: Cov(x, b) = A Cov_b.
+    full_covariance = Eigen::MatrixXd::Zero(12, 12);
+    full_covariance.topLeftCorner(9, 9) = cov_x;
+    full_covariance.topRightCorner(9, 3) = A * var_b.asDiagonal();
+    full_covariance.bottomLeftCorner(3, 9) = full_covariance.topRightCorner(9, 3).transpose();
+    full_covariance.bottomRightCorner(3, 3) = var_b.asDiagonal();
   }
   // Bias from the initial static period; 1 sigma = sample std / sqrt(samples) (white noise).
   const char* axes = "xyz";
@@ -395,11 +401,28 @@ GyroCalibration CalibrateGyros(const RawImuRecording& recording,
     out.fit.parameters.push_back({fmt::format("gyro.bias.{}", axes[i]), out.b_g[i], "rad/s",
                                   init.std_omega_ib_s[i] / std::sqrt(double(init.count()))});
   }
+  out.fit.SetCorrelation(full_covariance);
   out.fit.messages.push_back(fmt::format(
       "gyro bias from the initial static period ({:.1f} s, {} samples); Earth rate is not "
       "modelled (error up to 7.3e-5 rad/s x rotation time)",
       init.t_end_s - init.t_begin_s, init.count()));
   return out;
+}
+
+void CalibrationFit::SetCorrelation(const Eigen::MatrixXd& covariance) {
+  const size_t n = parameters.size();
+  const auto m = static_cast<size_t>(covariance.rows());
+  correlation.assign(n * n, 0.0);
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = 0; j < n; ++j) {
+      if (i == j) {
+        correlation[i * n + j] = 1.0;
+      } else if (i < m && j < m) {
+        const double d = std::sqrt(covariance(i, i) * covariance(j, j));
+        correlation[i * n + j] = d > 0 ? covariance(i, j) / d : 0.0;
+      }
+    }
+  }
 }
 
 void TruthInCalibrationFrame(const Eigen::Matrix3d& T_a_full, const Eigen::Matrix3d& T_g_full,

@@ -49,9 +49,10 @@ void PrintFit(const v1::CalibrationFitResult& fit) {
 
 int RunCalibrate(CalibrateOptions o) {
   v1::CalibrationResult result;
+  jobspec::NumericTable table;
   try {
     o.settings.data_name = o.data_path;
-    const jobspec::NumericTable table = jobspec::ReadNumericCsv(o.data_path);
+    table = jobspec::ReadNumericCsv(o.data_path);
     if (o.remote.server.empty()) {
       result = jobspec::RunCalibration(o.settings, table);
     } else if (const int status = RemoteCalibrate(o.remote, o.settings, table, &result);
@@ -75,7 +76,9 @@ int RunCalibrate(CalibrateOptions o) {
   }
   if (const int status = WriteOutputText(o.out_path, json, "--out")) return status;
   if (o.report_path.empty()) return kExitOk;
-  return WriteOutputText(o.report_path, jobspec::RenderCalibrationReport(result), "--report");
+  return WriteOutputText(o.report_path,
+                         jobspec::RenderCalibrationReport(result, &table, o.settings.rate_hz),
+                         "--report");
 }
 
 const RegisterCommand kCalibrate("calibrate", [](CLI::App& app) -> std::function<int()> {

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "../support/report_html.h"
 #include "driftlab/jobspec/gate.h"
 #include "driftlab/jobspec/html_report.h"
 #include "driftlab/jobspec/result_file.h"
@@ -689,23 +690,31 @@ TEST(Gate, DataFileDegradedCopyIsTheBaselineTimesOnePointFive) {
 // ---------------------------------------------------------------------------------------------
 // HTML report
 
-TEST(Report, IsOneSelfContainedFileWithAnSvgPerPlot) {
+TEST(Report, IsOneSelfContainedFileWithAnInteractivePlotEach) {
   const v1::JobResult result = MakeResult(1.0, 50, "<b>& \"job\"");
   const std::string html = RenderHtmlReport(result);
+  // Issue 20: dygraphs and report_plots.js are inline (<script> without src); nothing else loads.
+  const std::string markup = ::driftlab::testing::WithoutScriptText(html);
   for (const char* fetch :
-       {"http://", "https://", "src=", "<script", "<link", "@import", "url(", "<iframe", "<img"}) {
-    EXPECT_EQ(html.find(fetch), std::string::npos) << fetch;
+       {"http://", "https://", "src=", "<link", "@import", "url(", "<iframe", "<img"}) {
+    EXPECT_EQ(markup.find(fetch), std::string::npos) << fetch;
   }
-  // 11 envelopes + scatter + horizontal histogram + 10 other histograms.
-  EXPECT_EQ(Count(html, "<svg"), 23u);
-  EXPECT_EQ(Count(html, "</svg>"), 23u);
+  EXPECT_EQ(Count(html, "<script"), Count(html, "<script>"));
+  EXPECT_NE(html.find("Dygraph"), std::string::npos);
+  // 11 envelopes, the scatter, the horizontal histogram and 10 other histograms.
+  EXPECT_EQ(Count(html, "id=\"plot-envelope-"), 11u);
+  EXPECT_EQ(Count(html, "id=\"plot-scatter\""), 1u);
+  EXPECT_EQ(Count(html, "id=\"plot-histogram-"), 11u);
   // The job name escaped everywhere (title, heading, job echo), never raw.
-  EXPECT_EQ(html.find("<b>&"), std::string::npos);
+  EXPECT_EQ(markup.find("<b>&"), std::string::npos);
   EXPECT_GE(Count(html, "&lt;b&gt;&amp; &quot;job&quot;"), 2u);
   EXPECT_NE(html.find("engine version"), std::string::npos);
   EXPECT_NE(html.find("CEP95"), std::string::npos);
-  // One scatter dot per run (circles with r="1.8"), and the two CEP circles.
-  EXPECT_EQ(Count(html, "r=\"1.8\""), 50u);
+  // One scatter point per run, each with the command that regenerates it.
+  EXPECT_EQ(Count(html, "driftlab simulate job.json --run "), 50u);
+  EXPECT_NE(html.find("driftlab simulate job.json --run 49 --out run-49"), std::string::npos);
+  // The job echo is collapsible.
+  EXPECT_NE(html.find("<details><summary>Job as run"), std::string::npos);
   EXPECT_EQ(html.substr(0, 15), "<!DOCTYPE html>");
   EXPECT_EQ(html.substr(html.size() - 8), "</html>\n");
 
@@ -713,15 +722,17 @@ TEST(Report, IsOneSelfContainedFileWithAnSvgPerPlot) {
   v1::JobResult no_runs = result;
   for (v1::Checkpoint& checkpoint : *no_runs.mutable_checkpoints()) checkpoint.clear_runs();
   const std::string short_html = RenderHtmlReport(no_runs);
-  EXPECT_EQ(Count(short_html, "<svg"), 11u);
+  EXPECT_EQ(Count(short_html, "id=\"plot-envelope-"), 11u);
+  EXPECT_EQ(Count(short_html, "id=\"plot-scatter\""), 0u);
   EXPECT_NE(short_html.find("keeps no per-run values"), std::string::npos);
 }
 
 TEST(Report, DataFileResultRendersAndIsWellFormedXml) {
-  // The committed synthetic result (tests/cli/data/gate_make_results.py): its SVG and tables
-  // must be well-formed markup; Python's XML parser reads the report body after the doctype
+  // The committed synthetic result (tests/cli/data/gate_make_results.py): its markup (script
+  // text removed) must be well formed; Python's XML parser reads the report body after the doctype
   // (the report uses only XML-compatible HTML: every element closed, entities escaped).
-  std::string html = RenderHtmlReport(ReadJobResult(kData / "gate_baseline.json"));
+  std::string html = ::driftlab::testing::WithoutScriptText(
+      RenderHtmlReport(ReadJobResult(kData / "gate_baseline.json")));
   for (const char* entity : {"&sigma;", "&plusmn;"}) {
     for (size_t at = html.find(entity); at != std::string::npos; at = html.find(entity)) {
       html.replace(at, std::strlen(entity), "s");

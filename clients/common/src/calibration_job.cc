@@ -235,6 +235,7 @@ void AddFit(const calib::CalibrationFit& fit, v1::CalibrationResult* result) {
   for (double r : fit.residuals) out->add_residuals(r);
   out->set_fit_time_s(fit.fit_time_s);
   for (const std::string& m : fit.messages) out->add_messages(m);
+  for (double rho : fit.correlation) out->add_correlation(rho);
 }
 
 void CheckTable(const NumericTable& table, size_t columns, const std::string& expected) {

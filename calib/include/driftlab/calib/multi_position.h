@@ -63,6 +63,11 @@ struct CalibrationFit {
   int poses_used = 0;
   double fit_time_s = 0.0;
   std::vector<std::string> messages;
+  // Correlation matrix of `parameters`, row-major; empty when not computed.
+  std::vector<double> correlation;
+  // Sets `correlation` from a covariance of the first covariance.rows() parameters (the others,
+  // if any, uncorrelated with them and with each other).
+  void SetCorrelation(const Eigen::MatrixXd& covariance);
 
   const FitParameter& Find(const std::string& name) const;  // throws std::out_of_range
 };

@@ -1,13 +1,22 @@
-// HTML report of a Monte-Carlo result: one self-contained file (inline SVG and CSS, no script, no
-// external resource), readable offline and attachable to a design review or a CI artifact.
+// HTML report of a Monte-Carlo result: one self-contained file (CSS, the embedded plotting library
+// and the plot data inline; nothing loaded), readable offline and attachable to a design review or
+// a CI artifact. The plots are interactive (zoom, pan, cursor values, log/linear, series toggles,
+// PNG export; clients/common/src/interactive_plot.h).
 //
-// Contents: the job's name and description; engine version, seed, runs, run range, timings;
-// summary table of the final epoch (mean, sigma and RMS with their 95 % confidence intervals,
-// percentiles of |error|, CEP50/CEP95/2DRMS) and a percentile table per further checkpoint; error
-// envelopes against time per component (mean +- sigma band, mean, +-RMS); the final horizontal
-// scatter (east vs north per run, with the CEP50 and CEP95 circles about the true position);
-// histograms of the final horizontal error and of every other component; the job echo as JSON.
-// All text from the result is HTML-escaped. Angles in degrees, other units SI, as in the result.
+// Contents: the job's name and description; first screen: CEP50/CEP95 at the final epoch with
+// their 95 % intervals (order statistics of the runs' horizontal errors) and the final sigma of
+// position, velocity and attitude with theirs, what was simulated (motion length, distance and top
+// speed regenerated from the job echo, IMU model figures in datasheet units, mechanization, aiding,
+// filter, runs), the true trajectory north against east, the consistency verdict (filter or
+// covariance analysis); the summary table of the final epoch (mean, sigma and RMS with their 95 %
+// confidence intervals, percentiles of |error|, CEP50/CEP95/2DRMS; one fixed-point format per row)
+// and, collapsed, a percentile table per further checkpoint; error envelopes against time per
+// component (mean +- sigma band, +-RMS, the prediction when present) with GNSS outages and ZUPT
+// periods shaded; the NEES plot; the final horizontal scatter (east vs north per run, with the
+// CEP50 and CEP95 circles; hovering a point shows its run index and the `driftlab simulate --run`
+// command that regenerates it); histograms of the final horizontal error and of every other
+// component; run facts (engine version, timings); the job echo as JSON, collapsed. All text from
+// the result is HTML-escaped. Angles in degrees, other units SI, as in the result.
 #pragma once
 
 #include <string>
