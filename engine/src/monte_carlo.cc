@@ -163,17 +163,17 @@ void ValidateFilter(const MonteCarloSpec& spec) {
   only_with(a.magnetometer.has_value(), "aiding.magnetometer", "COMPLEMENTARY");
   if (spec.filter_flicker_states_per_axis < 1 ||
       spec.filter_flicker_states_per_axis > kMaxFlickerComponents) {
-    throw SpecError("filter.flicker_states_per_axis",
+    throw SpecError("navigation.ekf.flicker_states_per_axis",
                     std::to_string(spec.filter_flicker_states_per_axis),
                     "[1, " + std::to_string(kMaxFlickerComponents) + "]");
   }
   if (spec.filter_sensor) {
     if (f != NavigationFilterKind::kInsGnssEkf && !spec.covariance) {
-      throw SpecError("filter.sensor", "set",
+      throw SpecError("navigation.ekf.sensor", "set",
                       "only with navigation.filter INS_GNSS_EKF or the covariance analysis (the "
                       "filter is " + name + ")");
     }
-    ValidateImuErrorModel(*spec.filter_sensor, "filter.sensor");
+    ValidateImuErrorModel(*spec.filter_sensor, "navigation.ekf.sensor");
   }
   if (f == NavigationFilterKind::kInsGnssEkf) {
     if (!a.gnss && !a.barometer && !a.zupt) {
@@ -855,11 +855,11 @@ ErrorStateNoiseFromImu FilterErrorModel(const MonteCarloSpec& spec, const Shared
   ErrorStateNoiseFromImu out;
   const std::optional<ImuErrorModel>& model = spec.filter_sensor ? spec.filter_sensor : spec.sensor;
   if (model) {
-    out = MakeErrorStateNoise(*model, spec.filter_sensor ? "filter.sensor" : "sensor", options);
+    out = MakeErrorStateNoise(*model, spec.filter_sensor ? "navigation.ekf.sensor" : "sensor", options);
   }
   if (spec.filter_sensor) {
     static const std::string kMistuned =
-        "filter.sensor (the filter assumes this model, not the truth's sensor: the predicted sigma "
+        "navigation.ekf.sensor (the filter assumes this model, not the truth's sensor: the predicted sigma "
         "is the filter's belief, a mistuning shows as NEES outside its band)";
     out.unrepresented.push_back(kMistuned);
   }

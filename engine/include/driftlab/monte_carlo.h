@@ -124,7 +124,8 @@ struct MonteCarloSpec {
   NavigationFilterKind filter = NavigationFilterKind::kNone;
   AidingSpec aiding;
   int64_t ekf_propagation_step_samples = 10;  // InsGnssFilterOptions::propagation_step_samples
-  // What the EKF and the covariance analysis assume (issue 18; error_state.h MakeErrorStateNoise):
+  // What the EKF and the covariance analysis assume (issue 18; error_state.h MakeErrorStateNoise;
+  // job fields navigation.ekf.sensor, .augment_scale_misalignment, .flicker_states_per_axis):
   //  * filter_sensor: the IMU model the filter assumes; absent = the truth model `sensor` (set it
   //    to study a mistuned filter: the consistency check then compares the filter's belief with
   //    the truth's Monte-Carlo spread);
