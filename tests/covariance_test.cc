@@ -162,13 +162,14 @@ TEST(ErrorStateModel, NoiseFromImuRepresentsEveryStochasticTermAndNamesTheRest) 
   EXPECT_FALSE(has("sensor.accel.scale_factor"));
   EXPECT_FALSE(has("sensor.gyro.misalignment"));
   EXPECT_TRUE(has("sensor.gyro.range"));  // saturation: named with its effect
-  // Turn-on bias in the core bias state, flicker as 3 Gauss-Markov states per axis, scale factor
-  // (3) and misalignment (6) per triad: 15 + 2 x (3 x 3) + 2 x 9 = 51 states.
+  // Turn-on bias in the core bias state, flicker as its design's d Gauss-Markov states per axis,
+  // scale factor (3) and misalignment (6) per triad: 15 + 2 x 3 d + 2 x 9 states.
   const ErrorStateLayout layout(full.noise);
+  const size_t d = DesignFlickerApproximation(FindImuPreset("tactical").gyro.bias_flicker).size();
   EXPECT_EQ(full.noise.gyro_bias.initial_sigma, FindImuPreset("tactical").gyro.turn_on_bias_sigma);
-  EXPECT_EQ(layout.gyro_bias_extra.size(), 3u);
-  EXPECT_EQ(layout.accel_bias_extra.size(), 3u);
-  EXPECT_EQ(layout.size, 51);
+  EXPECT_EQ(layout.gyro_bias_extra.size(), d);
+  EXPECT_EQ(layout.accel_bias_extra.size(), d);
+  EXPECT_EQ(layout.size, static_cast<int>(15 + 6 * d + 18));
   const ErrorStateNoiseFromImu rep = MakeErrorStateNoise(TacticalRepresentable());
   EXPECT_TRUE(rep.unrepresented.empty());
   EXPECT_EQ(ErrorStateLayout(rep.noise).size, kNumErrorStates);
@@ -181,9 +182,12 @@ TEST(ErrorStateModel, NoiseFromImuRepresentsEveryStochasticTermAndNamesTheRest) 
   no_aug.unaided_interval_s = 60.0;
   const ErrorStateNoiseFromImu bound = MakeErrorStateNoise(FindImuPreset("tactical"), "sensor",
                                                            no_aug);
-  EXPECT_EQ(ErrorStateLayout(bound.noise).size, 51 - 18);
-  // q = max_i (s^2 w_i^2 + m^2 sum_{j != i} w_j^2) T: the z axis, 300 ppm, 0.5 mrad.
-  const double q = (std::pow(300e-6 * 1.0, 2) + std::pow(0.5e-3, 2) * 0.02) * 60.0;
+  EXPECT_EQ(ErrorStateLayout(bound.noise).size, layout.size - 18);
+  // q = max_i (s^2 w_i^2 + m^2 sum_{j != i} w_j^2) T with 300 ppm, 0.5 mrad: the x (and y) axis,
+  // whose misalignment picks up the 1 rad/s of z, beats z's own scale factor.
+  const double q_x = std::pow(300e-6 * 0.1, 2) + std::pow(0.5e-3, 2) * (0.01 + 1.0);
+  const double q_z = std::pow(300e-6 * 1.0, 2) + std::pow(0.5e-3, 2) * 0.02;
+  const double q = std::max(q_x, q_z) * 60.0;
   EXPECT_NEAR(bound.noise.gyro_white_psd - full.noise.gyro_white_psd, q, 1e-15);
 }
 
@@ -224,7 +228,9 @@ TEST(ErrorStateModel, StructuredPropagationEqualsTheDenseSecondOrderStep) {
   // equal to rounding (1e-12 relative, 51 states, sums of a few hundred products).
   MotionSpec m = CarMotion();
   const Trajectory t = GenerateTrajectory(m, 50.0);
-  ErrorStateNoise noise = MakeErrorStateNoise(FindImuPreset("tactical")).noise;
+  ErrorModelOptions three;
+  three.flicker_states_per_axis = 3;
+  ErrorStateNoise noise = MakeErrorStateNoise(FindImuPreset("tactical"), "sensor", three).noise;
   noise.gnss_position_gm_sigma_ned_m = Vector3d(0.5, 0.5, 1.0);
   noise.gnss_position_gm_tau_s = 100.0;
   noise.barometer_bias_sigma_m = 2.0;

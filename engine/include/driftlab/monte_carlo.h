@@ -132,10 +132,10 @@ struct MonteCarloSpec {
   //  * filter_augment_scale_misalignment: scale factor and misalignment as augmented states, or
   //    (false) as a white-noise bound derived from the motion;
   //  * filter_flicker_states_per_axis: Gauss-Markov states per axis for flicker, 1 to
-  //    kMaxFlickerComponents.
+  //    kMaxFlickerComponents (default: every component of the simulator's design).
   std::optional<ImuErrorModel> filter_sensor;
   bool filter_augment_scale_misalignment = true;
-  int filter_flicker_states_per_axis = 3;
+  int filter_flicker_states_per_axis = kMaxFlickerComponents;
   // kComplementary: kind and crossover frequencies (magnetic_declination_rad and initial_yaw_rad
   // are set per run from the magnetometer's field and the initial errors).
   ComplementaryFilterOptions complementary;
