@@ -91,8 +91,8 @@ TEST(ErrorStateModel, LinearModelReproducesMechanizationErrorPropagation) {
       const Vector3d f_b = t.increments[k].delta_v_ib_b / t.dt_s;
       const ErrorStateMatrix F = ErrorStateSystemMatrix(t.environment, t.truth[k], f_b, noise);
       ErrorStateMatrix Phi, Qd;
-      DiscretizeErrorModel(F, ErrorStateMatrix::Zero(kNumErrorStates, kNumErrorStates), t.dt_s, Discretization::kSecondOrder, &Phi,
-                           &Qd);
+      DiscretizeErrorModel(F, ErrorStateMatrix::Zero(kNumErrorStates, kNumErrorStates), t.dt_s,
+                           Discretization::kSecondOrder, &Phi, &Qd);
       x = Phi * x;
       for (int g = 0; g < 3; ++g) {
         const double scale = mech[k].segment<3>(3 * g).norm() + 1e-9;
@@ -180,8 +180,8 @@ TEST(ErrorStateModel, NoiseFromImuRepresentsEveryStochasticTermAndNamesTheRest) 
   no_aug.augment_scale_misalignment = false;
   no_aug.max_abs_omega_ib_b = Vector3d(0.1, 0.1, 1.0);
   no_aug.unaided_interval_s = 60.0;
-  const ErrorStateNoiseFromImu bound = MakeErrorStateNoise(FindImuPreset("tactical"), "sensor",
-                                                           no_aug);
+  const ErrorStateNoiseFromImu bound =
+      MakeErrorStateNoise(FindImuPreset("tactical"), "sensor", no_aug);
   EXPECT_EQ(ErrorStateLayout(bound.noise).size, layout.size - 18);
   // q = max_i (s^2 w_i^2 + m^2 sum_{j != i} w_j^2) T with 300 ppm, 0.5 mrad: the x (and y) axis,
   // whose misalignment picks up the 1 rad/s of z, beats z's own scale factor.
@@ -238,10 +238,10 @@ TEST(ErrorStateModel, StructuredPropagationEqualsTheDenseSecondOrderStep) {
   const ErrorStateLayout layout(noise);
   ASSERT_EQ(layout.size, 55);
   Eigen::MatrixXd A = Eigen::MatrixXd::Random(layout.size, layout.size) * 1e-3;
-  const ErrorStateMatrix P0 = A * A.transpose() +
-                              InitialErrorCovariance(Vector3d(1, 1, 2), Vector3d(0.1, 0.1, 0.1),
-                                                     Vector3d(1e-3, 1e-3, 5e-3),
-                                                     t.truth[0].euler(), noise);
+  const ErrorStateMatrix P0 =
+      A * A.transpose() + InitialErrorCovariance(Vector3d(1, 1, 2), Vector3d(0.1, 0.1, 0.1),
+                                                 Vector3d(1e-3, 1e-3, 5e-3), t.truth[0].euler(),
+                                                 noise);
   ErrorCovariancePropagator prop(t.environment, noise, P0, Discretization::kSecondOrder);
   const size_t k = 400;
   const Vector3d f_b = t.increments[k].delta_v_ib_b / t.dt_s;

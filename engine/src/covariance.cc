@@ -52,8 +52,8 @@ void ErrorCovariancePropagator::Propagate(const NavState& reference, const Vecto
   const auto P_nn = P_.topLeftCorner(n, n);
   const auto P_ns = P_.topRightCorner(n, m);
   const auto P_ss = P_.bottomRightCorner(m, m);
-  BPss_ = B_ * P_ss;                           // n x m
-  Pns_ = A_ * P_ns + BPss_;                    // (Phi P)_ns before the diag(d) on the right
+  BPss_ = B_ * P_ss;         // n x m
+  Pns_ = A_ * P_ns + BPss_;  // (Phi P)_ns before the diag(d) on the right
   Pnn_ = A_ * P_nn * A_.transpose() + A_ * P_ns * B_.transpose() +
          (A_ * P_ns * B_.transpose()).transpose() + BPss_ * B_.transpose();
   // Q_d = dt / 2 (Phi Q_c Phi^T + Q_c), Q_c = diag(q_n, q_s).
@@ -71,7 +71,8 @@ void ErrorCovariancePropagator::Propagate(const NavState& reference, const Vecto
   P_.bottomRightCorner(m, m) = d_.asDiagonal() * P_ss * d_.asDiagonal();
   P_.bottomRightCorner(m, m).diagonal() += Qd_ss;
   P_.bottomLeftCorner(m, n) = P_.topRightCorner(n, m).transpose();
-  P_.topLeftCorner(n, n) = 0.5 * (P_.topLeftCorner(n, n) + P_.topLeftCorner(n, n).transpose()).eval();
+  P_.topLeftCorner(n, n) =
+      0.5 * (P_.topLeftCorner(n, n) + P_.topLeftCorner(n, n).transpose()).eval();
 }
 
 CovarianceEpoch MakeCovarianceEpoch(double t_s, const ErrorStateMatrix& P,

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
 #include <unsupported/Eigen/MatrixFunctions>
+#include <utility>
 
 #include "driftlab/attitude.h"
 #include "driftlab/sensors.h"
@@ -31,8 +31,8 @@ void BiasModelOf(const TriadErrorParams& p, const std::string& path,
     // bias started at 0 (gnss-ins-sim's convention) has no initial uncertainty.
     gm_state.initial_sigma = p.bias_gauss_markov.start_at_zero ? 0.0 : p.bias_gauss_markov.sigma;
     gm_state.tau_s = p.bias_gauss_markov.tau_s;
-    gm_state.driving_psd = 2.0 * p.bias_gauss_markov.sigma * p.bias_gauss_markov.sigma /
-                           p.bias_gauss_markov.tau_s;
+    gm_state.driving_psd =
+        2.0 * p.bias_gauss_markov.sigma * p.bias_gauss_markov.sigma / p.bias_gauss_markov.tau_s;
   }
   BiasStateModel walk;
   walk.initial_sigma = p.turn_on_bias_sigma;
@@ -42,8 +42,8 @@ void BiasModelOf(const TriadErrorParams& p, const std::string& path,
   if (gm) states.push_back(gm_state);
   if (p.bias_flicker.bias_instability > 0.0) {
     for (const BiasStateModel& f :
-         FitFlickerStates(p.bias_flicker, options.flicker_states_per_axis,
-                          options.time_scale_min_s, options.time_scale_max_s)) {
+         FitFlickerStates(p.bias_flicker, options.flicker_states_per_axis, options.time_scale_min_s,
+                          options.time_scale_max_s)) {
       states.push_back(f);
     }
   }
@@ -182,8 +182,8 @@ ErrorStateNoiseFromImu MakeErrorStateNoise(const ImuErrorModel& model, const std
     for (const auto& [sm, name] : {std::pair{gyro_sm, ".gyro"}, std::pair{accel_sm, ".accel"}}) {
       if (HasScaleMisalignment(sm)) {
         out.unrepresented.push_back(
-            path + name +
-            ".scale_factor/misalignment (as a white-noise bound over " + std::to_string(T) +
+            path + name + ".scale_factor/misalignment (as a white-noise bound over " +
+            std::to_string(T) +
             " s, filter.augment_scale_misalignment = false: conservative, NEES below its band)");
       }
     }

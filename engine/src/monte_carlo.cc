@@ -171,7 +171,8 @@ void ValidateFilter(const MonteCarloSpec& spec) {
     if (f != NavigationFilterKind::kInsGnssEkf && !spec.covariance) {
       throw SpecError("navigation.ekf.sensor", "set",
                       "only with navigation.filter INS_GNSS_EKF or the covariance analysis (the "
-                      "filter is " + name + ")");
+                      "filter is " +
+                          name + ")");
     }
     ValidateImuErrorModel(*spec.filter_sensor, "navigation.ekf.sensor");
   }
@@ -841,7 +842,8 @@ ErrorStateNoiseFromImu FilterErrorModel(const MonteCarloSpec& spec, const Shared
   if (ekf && spec.aiding.gnss) {
     aid_interval_s = 1.0 / spec.aiding.gnss->rate_hz;
     unaided_s = aid_interval_s;
-    for (const GnssOutage& o : spec.aiding.gnss->outages) unaided_s = std::max(unaided_s, o.duration_s);
+    for (const GnssOutage& o : spec.aiding.gnss->outages)
+      unaided_s = std::max(unaided_s, o.duration_s);
   }
   options.time_scale_min_s = std::max(aid_interval_s, s.dt_s);
   options.time_scale_max_s = std::max(duration_s, options.time_scale_min_s);
@@ -855,11 +857,13 @@ ErrorStateNoiseFromImu FilterErrorModel(const MonteCarloSpec& spec, const Shared
   ErrorStateNoiseFromImu out;
   const std::optional<ImuErrorModel>& model = spec.filter_sensor ? spec.filter_sensor : spec.sensor;
   if (model) {
-    out = MakeErrorStateNoise(*model, spec.filter_sensor ? "navigation.ekf.sensor" : "sensor", options);
+    out = MakeErrorStateNoise(*model, spec.filter_sensor ? "navigation.ekf.sensor" : "sensor",
+                              options);
   }
   if (spec.filter_sensor) {
     static const std::string kMistuned =
-        "navigation.ekf.sensor (the filter assumes this model, not the truth's sensor: the predicted sigma "
+        "navigation.ekf.sensor (the filter assumes this model, not the truth's sensor: the "
+        "predicted sigma "
         "is the filter's belief, a mistuning shows as NEES outside its band)";
     out.unrepresented.push_back(kMistuned);
   }

@@ -224,10 +224,10 @@ void TranslateFilterAndAiding(const v1::Job& job, const MonteCarloOverrides& ove
   }
   spec->filter_augment_scale_misalignment =
       !nav.ekf().has_augment_scale_misalignment() || nav.ekf().augment_scale_misalignment();
-  spec->filter_flicker_states_per_axis = static_cast<int>(OptionalOr(
-      "navigation.ekf.flicker_states_per_axis", nav.ekf().has_flicker_states_per_axis(),
-      nav.ekf().flicker_states_per_axis(), static_cast<double>(kMaxFlickerComponents),
-      Closed(1.0, static_cast<double>(kMaxFlickerComponents), "states")));
+  spec->filter_flicker_states_per_axis = static_cast<int>(
+      OptionalOr("navigation.ekf.flicker_states_per_axis", nav.ekf().has_flicker_states_per_axis(),
+                 nav.ekf().flicker_states_per_axis(), static_cast<double>(kMaxFlickerComponents),
+                 Closed(1.0, static_cast<double>(kMaxFlickerComponents), "states")));
   const v1::ComplementaryOptions& c = nav.complementary();
   switch (c.pair()) {
     case v1::ComplementaryOptions::PAIR_UNSPECIFIED:

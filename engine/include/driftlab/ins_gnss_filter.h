@@ -25,8 +25,9 @@
 //     the residual motion), H = [0, I, 0, 0, 0], R = sigma^2 I;
 //   * closed loop: the estimated error x = K z is removed from the navigation state at once
 //     (position and velocity subtracted, attitude C_b_n <- exp(-[psi x]) C_b_n) and added to the
-//     sensor-error estimates (biases, scale factor, misalignment, aiding errors), then x = 0. The mechanization restarts from the corrected state, so its
-//     first step after a fix uses single-sample coning/sculling (O(dt^2) per fix).
+//     sensor-error estimates (biases, scale factor, misalignment, aiding errors), then x = 0. The
+//     mechanization restarts from the corrected state, so its first step after a fix uses
+//     single-sample coning/sculling (O(dt^2) per fix).
 // The bias states are the residual errors of the corrected measurements: x_ba = b_a - b^_a,
 // x_bg = b_g - b^_g (the corrected specific force minus the true one).
 #pragma once
