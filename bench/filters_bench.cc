@@ -60,45 +60,68 @@ BENCHMARK(BM_ComplementaryFilter)
     ->Arg(static_cast<int>(ComplementaryPairKind::kButterworth4))
     ->Arg(static_cast<int>(ComplementaryPairKind::kButterworth4Seed));
 
-// One covariance propagation step (F, discretisation, P update); arg 0 = Van Loan, 1 = 2nd order.
+// The tactical preset: augmented = 0 reduced to the 15 core states (no flicker, scale factor,
+// misalignment: the model before issue 18), 1 the whole preset (87 states: flicker as 9
+// Gauss-Markov states per axis, scale factor and misalignment augmented).
+ImuErrorModel TacticalModel(int64_t augmented) {
+  ImuErrorModel model = FindImuPreset("tactical");
+  if (augmented == 0) {
+    for (TriadErrorParams* p : {&model.gyro, &model.accel}) {
+      p->bias_flicker = {};
+      p->scale_factor_sigma = 0.0;
+      p->misalignment_sigma_rad = 0.0;
+    }
+  }
+  return model;
+}
+
+ErrorStateMatrix SmallIdentity(const ErrorStateNoise& noise) {
+  const int n = ErrorStateLayout(noise).size;
+  return ErrorStateMatrix::Identity(n, n) * 1e-4;
+}
+
+// One covariance propagation step (F, discretisation, P update); arg 0: 0 = Van Loan, 1 = 2nd
+// order (structured); arg 1: 0 = 15 states, 1 = augmented.
 void BM_CovariancePropagationStep(benchmark::State& state) {
   const Trajectory& t = Drive();
-  const ErrorStateNoise noise = MakeErrorStateNoise(FindImuPreset("tactical")).noise;
+  const ErrorStateNoise noise = MakeErrorStateNoise(TacticalModel(state.range(1))).noise;
   ErrorCovariancePropagator p(
-      t.environment, noise, ErrorStateMatrix::Identity() * 1e-4,
+      t.environment, noise, SmallIdentity(noise),
       state.range(0) == 0 ? Discretization::kVanLoan : Discretization::kSecondOrder);
   size_t k = 0;
   for (auto _ : state) {
-    p.Propagate(t.truth[k], t.samples[k].f_ib_b, 0.1);
+    p.Propagate(t.truth[k], t.samples[k].f_ib_b, 0.1, t.samples[k].omega_ib_b);
     k = (k + 1) % t.samples.size();
     benchmark::DoNotOptimize(p.P().data());
   }
   state.SetItemsProcessed(state.iterations());
 }
-BENCHMARK(BM_CovariancePropagationStep)->Arg(0)->Arg(1);
+BENCHMARK(BM_CovariancePropagationStep)->Args({0, 0})->Args({1, 0})->Args({0, 1})->Args({1, 1});
 
-// Linear covariance analysis along the drive, per IMU sample, for step_samples = range(0).
+// Linear covariance analysis along the drive, per IMU sample, for step_samples = range(0); range(1)
+// 0 = 15 states, 1 = augmented.
 void BM_FreeInertialCovariancePerSample(benchmark::State& state) {
   const Trajectory& t = Drive();
-  const ErrorStateNoise noise = MakeErrorStateNoise(FindImuPreset("tactical")).noise;
+  const ErrorStateNoise noise = MakeErrorStateNoise(TacticalModel(state.range(1))).noise;
   CovarianceAnalysisOptions o;
   o.step_samples = state.range(0);
   o.epoch_every_samples = 100 * o.step_samples;
   o.discretization = Discretization::kSecondOrder;
   int64_t samples = 0;
   for (auto _ : state) {
-    auto out = FreeInertialCovariance(t, noise, ErrorStateMatrix::Identity() * 1e-4, o);
+    auto out = FreeInertialCovariance(t, noise, SmallIdentity(noise), o);
     benchmark::DoNotOptimize(out.data());
     samples += static_cast<int64_t>(t.increments.size());
   }
   state.SetItemsProcessed(samples);
 }
-BENCHMARK(BM_FreeInertialCovariancePerSample)->Arg(1)->Arg(10);
+BENCHMARK(BM_FreeInertialCovariancePerSample)->Args({1, 0})->Args({10, 0})->Args({10, 1});
 
-// INS/GNSS filter per IMU sample: measured increments precomputed (sensor model not timed).
+// INS/GNSS filter per IMU sample: measured increments precomputed (sensor model not timed);
+// arg 0 = 15 states, 1 = augmented.
 void BM_InsGnssFilterPerSample(benchmark::State& state) {
   const Trajectory& t = Drive();
-  ImuErrorModel model = FindImuPreset("tactical");
+  const ImuErrorModel model = TacticalModel(state.range(0));
   ImuErrorSimulator imu(model, 1, 0, 100.0);
   std::vector<ImuIncrement> measured(t.increments.size());
   for (size_t k = 0; k < measured.size(); ++k) imu.Apply(t.increments[k], &measured[k]);
@@ -128,7 +151,7 @@ void BM_InsGnssFilterPerSample(benchmark::State& state) {
   }
   state.SetItemsProcessed(samples);
 }
-BENCHMARK(BM_InsGnssFilterPerSample);
+BENCHMARK(BM_InsGnssFilterPerSample)->Arg(0)->Arg(1);
 
 }  // namespace
 }  // namespace driftlab

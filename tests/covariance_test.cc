@@ -14,6 +14,7 @@
 #include "driftlab/mc_statistics.h"
 #include "driftlab/monte_carlo.h"
 #include "driftlab/presets.h"
+#include "driftlab/sensors.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/trajectory.h"
 #include "support/bonferroni_checks.h"
@@ -63,7 +64,7 @@ std::vector<ErrorStateVector> MechanizationErrors(const Trajectory& t, const Err
     m.delta_theta_ib_b += e0.segment<3>(kErrGyroBias) * t.dt_s;
     ins.Update(m);
     const NavError err = ComputeNavError(t.environment, ins.state(), t.truth[k + 1]);
-    ErrorStateVector x = ErrorStateVector::Zero();
+    ErrorStateVector x = ErrorStateVector::Zero(kNumErrorStates);
     x.segment<3>(kErrPosition) = err.r_ned_m;
     x.segment<3>(kErrVelocity) = err.v_ned_m_per_s;
     x.segment<3>(kErrAttitude) = err.psi_nb_n_rad;
@@ -80,7 +81,7 @@ TEST(ErrorStateModel, LinearModelReproducesMechanizationErrorPropagation) {
   const double sizes[5] = {1.0, 0.05, 0.5e-3, 1e-3 * 9.80665, 5.0 * kDeg / 3600.0};
   ErrorStateNoise noise;  // no decay: constant biases
   for (int block = 0; block < 5; ++block) {
-    ErrorStateVector e0 = ErrorStateVector::Zero();
+    ErrorStateVector e0 = ErrorStateVector::Zero(kNumErrorStates);
     e0.segment<3>(3 * block) = Vector3d(1.0, -0.7, 0.4) * sizes[block];
     const std::vector<ErrorStateVector> mech = MechanizationErrors(t, e0);
     // Linear prediction: x(k+1) = Phi(k) x(k) with F at the truth (Van Loan, 1 sample).
@@ -90,8 +91,8 @@ TEST(ErrorStateModel, LinearModelReproducesMechanizationErrorPropagation) {
       const Vector3d f_b = t.increments[k].delta_v_ib_b / t.dt_s;
       const ErrorStateMatrix F = ErrorStateSystemMatrix(t.environment, t.truth[k], f_b, noise);
       ErrorStateMatrix Phi, Qd;
-      DiscretizeErrorModel(F, ErrorStateMatrix::Zero(), t.dt_s, Discretization::kSecondOrder, &Phi,
-                           &Qd);
+      DiscretizeErrorModel(F, ErrorStateMatrix::Zero(kNumErrorStates, kNumErrorStates), t.dt_s,
+                           Discretization::kSecondOrder, &Phi, &Qd);
       x = Phi * x;
       for (int g = 0; g < 3; ++g) {
         const double scale = mech[k].segment<3>(3 * g).norm() + 1e-9;
@@ -151,19 +152,108 @@ ImuErrorModel TacticalRepresentable() {
   return model;
 }
 
-TEST(ErrorStateModel, NoiseFromImuListsWhatTheModelCannotRepresent) {
+TEST(ErrorStateModel, NoiseFromImuRepresentsEveryStochasticTermAndNamesTheRest) {
   const ErrorStateNoiseFromImu full = MakeErrorStateNoise(FindImuPreset("tactical"));
-  auto has = [&](const std::string& s) {
-    return std::find(full.unrepresented.begin(), full.unrepresented.end(), s) !=
-           full.unrepresented.end();
+  auto has = [&](const std::string& prefix) {
+    return std::any_of(full.unrepresented.begin(), full.unrepresented.end(),
+                       [&](const std::string& s) { return s.rfind(prefix, 0) == 0; });
   };
-  EXPECT_TRUE(has("sensor.gyro.bias_flicker"));
-  EXPECT_TRUE(has("sensor.accel.scale_factor"));
-  EXPECT_TRUE(has("sensor.gyro.misalignment"));
+  EXPECT_FALSE(has("sensor.gyro.bias_flicker"));
+  EXPECT_FALSE(has("sensor.accel.scale_factor"));
+  EXPECT_FALSE(has("sensor.gyro.misalignment"));
+  EXPECT_TRUE(has("sensor.gyro.range"));  // saturation: named with its effect
+  // Turn-on bias in the core bias state, flicker as its design's d Gauss-Markov states per axis,
+  // scale factor (3) and misalignment (6) per triad: 15 + 2 x 3 d + 2 x 9 states.
+  const ErrorStateLayout layout(full.noise);
+  const size_t d = DesignFlickerApproximation(FindImuPreset("tactical").gyro.bias_flicker).size();
+  EXPECT_EQ(full.noise.gyro_bias.initial_sigma, FindImuPreset("tactical").gyro.turn_on_bias_sigma);
+  EXPECT_EQ(layout.gyro_bias_extra.size(), d);
+  EXPECT_EQ(layout.accel_bias_extra.size(), d);
+  EXPECT_EQ(layout.size, static_cast<int>(15 + 6 * d + 18));
   const ErrorStateNoiseFromImu rep = MakeErrorStateNoise(TacticalRepresentable());
   EXPECT_TRUE(rep.unrepresented.empty());
+  EXPECT_EQ(ErrorStateLayout(rep.noise).size, kNumErrorStates);
   // 0.15 deg/sqrt(h) = 4.363e-5 rad/sqrt(s): PSD its square (exact conversion).
   EXPECT_NEAR(rep.noise.gyro_white_psd, std::pow(0.15 * kDeg / 60.0, 2), 1e-20);
+  // Without augmentation the scale factor and misalignment become a white-noise bound (named).
+  ErrorModelOptions no_aug;
+  no_aug.augment_scale_misalignment = false;
+  no_aug.max_abs_omega_ib_b = Vector3d(0.1, 0.1, 1.0);
+  no_aug.unaided_interval_s = 60.0;
+  const ErrorStateNoiseFromImu bound =
+      MakeErrorStateNoise(FindImuPreset("tactical"), "sensor", no_aug);
+  EXPECT_EQ(ErrorStateLayout(bound.noise).size, layout.size - 18);
+  // q = max_i (s^2 w_i^2 + m^2 sum_{j != i} w_j^2) T with 300 ppm, 0.5 mrad: the x (and y) axis,
+  // whose misalignment picks up the 1 rad/s of z, beats z's own scale factor.
+  const double q_x = std::pow(300e-6 * 0.1, 2) + std::pow(0.5e-3, 2) * (0.01 + 1.0);
+  const double q_z = std::pow(300e-6 * 1.0, 2) + std::pow(0.5e-3, 2) * 0.02;
+  const double q = std::max(q_x, q_z) * 60.0;
+  EXPECT_NEAR(bound.noise.gyro_white_psd - full.noise.gyro_white_psd, q, 1e-15);
+}
+
+TEST(ErrorStateModel, FittedFlickerStatesReproduceTheFlickerFloorOverTheRunsTimeScales) {
+  // Tactical gyro flicker B = 3 deg/h over 1..1000 s; fitted with 3 states over a run of 1..830 s.
+  const FlickerParams f = FindImuPreset("tactical").gyro.bias_flicker;
+  const std::vector<BiasStateModel> fit = FitFlickerStates(f, 3, 1.0, 830.0);
+  ASSERT_EQ(fit.size(), 3u);
+  std::vector<GaussMarkovComponent> components;
+  double variance = 0.0, design_variance = 0.0;
+  for (const BiasStateModel& b : fit) {
+    components.push_back({b.initial_sigma, b.tau_s});
+    variance += b.initial_sigma * b.initial_sigma;
+  }
+  for (const GaussMarkovComponent& c : DesignFlickerApproximation(f)) {
+    design_variance += c.sigma * c.sigma;
+  }
+  // Lumping keeps the total variance exactly (rounding only).
+  EXPECT_NEAR(variance / design_variance, 1.0, 1e-12);
+  // Allan deviation of the fit against the floor 0.664 B at averaging times inside the run's
+  // range: three states over three decades leave a ripple; a lumped group of components spanning
+  // a decade has an Allan curve within a factor 1.5 of their sum's (the Gauss-Markov Allan curve's
+  // peak is 0.617 sigma at 1.89 tau and falls as sqrt(t) and 1 / sqrt(t) on either side).
+  const double floor = std::sqrt(2.0 * std::log(2.0) / M_PI) * f.bias_instability;
+  for (double t : {2.0, 5.0, 10.0, 30.0, 100.0, 300.0}) {
+    const double adev = SumOfGaussMarkovAllanDeviation(components, t);
+    std::printf("t = %5.0f s: ADEV / flicker floor %.3f\n", t, adev / floor);
+    EXPECT_GT(adev / floor, 1.0 / 1.5) << t;
+    EXPECT_LT(adev / floor, 1.5) << t;
+  }
+  // count >= the design's size: the design itself.
+  EXPECT_EQ(FitFlickerStates(f, kMaxFlickerComponents, 1.0, 830.0).size(),
+            DesignFlickerApproximation(f).size());
+}
+
+TEST(ErrorStateModel, StructuredPropagationEqualsTheDenseSecondOrderStep) {
+  // The structured step (covariance.h) is the dense second-order Phi P Phi^T + Q_d rearranged:
+  // equal to rounding (1e-12 relative, 51 states, sums of a few hundred products).
+  MotionSpec m = CarMotion();
+  const Trajectory t = GenerateTrajectory(m, 50.0);
+  ErrorModelOptions three;
+  three.flicker_states_per_axis = 3;
+  ErrorStateNoise noise = MakeErrorStateNoise(FindImuPreset("tactical"), "sensor", three).noise;
+  noise.gnss_position_gm_sigma_ned_m = Vector3d(0.5, 0.5, 1.0);
+  noise.gnss_position_gm_tau_s = 100.0;
+  noise.barometer_bias_sigma_m = 2.0;
+  noise.barometer_bias_tau_s = 300.0;
+  const ErrorStateLayout layout(noise);
+  ASSERT_EQ(layout.size, 55);
+  Eigen::MatrixXd A = Eigen::MatrixXd::Random(layout.size, layout.size) * 1e-3;
+  const ErrorStateMatrix P0 =
+      A * A.transpose() + InitialErrorCovariance(Vector3d(1, 1, 2), Vector3d(0.1, 0.1, 0.1),
+                                                 Vector3d(1e-3, 1e-3, 5e-3), t.truth[0].euler(),
+                                                 noise);
+  ErrorCovariancePropagator prop(t.environment, noise, P0, Discretization::kSecondOrder);
+  const size_t k = 400;
+  const Vector3d f_b = t.increments[k].delta_v_ib_b / t.dt_s;
+  const Vector3d w_b = t.increments[k].delta_theta_ib_b / t.dt_s;
+  const double dt = 0.2;
+  prop.Propagate(t.truth[k], f_b, dt, w_b);
+  const ErrorStateMatrix F = ErrorStateSystemMatrix(t.environment, t.truth[k], f_b, noise, w_b);
+  ErrorStateMatrix Phi, Qd;
+  DiscretizeErrorModel(F, ErrorStateProcessNoise(noise), dt, Discretization::kSecondOrder, &Phi,
+                       &Qd);
+  const ErrorStateMatrix dense = Phi * P0 * Phi.transpose() + Qd;
+  EXPECT_LT((prop.P() - dense).norm() / dense.norm(), 1e-12);
 }
 
 // Acceptance criterion: support/bonferroni_checks.h (5 rule-picked epochs per component, every
@@ -206,7 +296,7 @@ TEST(LinearCovariance, BadOptionsNameTheField) {
   CovarianceAnalysisOptions o;
   o.step_samples = 0;
   try {
-    FreeInertialCovariance(t, {}, ErrorStateMatrix::Zero(), o);
+    FreeInertialCovariance(t, {}, ErrorStateMatrix::Zero(kNumErrorStates, kNumErrorStates), o);
     FAIL();
   } catch (const SpecError& e) {
     EXPECT_EQ(e.field(), "covariance.step_samples");
@@ -214,7 +304,7 @@ TEST(LinearCovariance, BadOptionsNameTheField) {
   o.step_samples = 3;
   o.epoch_every_samples = 10;
   try {
-    FreeInertialCovariance(t, {}, ErrorStateMatrix::Zero(), o);
+    FreeInertialCovariance(t, {}, ErrorStateMatrix::Zero(kNumErrorStates, kNumErrorStates), o);
     FAIL();
   } catch (const SpecError& e) {
     EXPECT_EQ(e.field(), "covariance.epoch_every_samples");

@@ -69,7 +69,8 @@ TEST(InsGnssFilter, BadAidingConfigurationNamesTheField) {
   InsGnssFilterOptions o;
   o.propagation_step_samples = 0;
   try {
-    InsGnssFilter f(NavEnvironment::Wgs84(), NavState(), ErrorStateMatrix::Identity(), 100.0, o);
+    InsGnssFilter f(NavEnvironment::Wgs84(), NavState(),
+                    ErrorStateMatrix::Identity(kNumErrorStates, kNumErrorStates), 100.0, o);
     FAIL();
   } catch (const SpecError& e) {
     EXPECT_EQ(e.field(), "filter.propagation_step_samples");

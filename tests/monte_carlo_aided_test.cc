@@ -122,9 +122,9 @@ TEST(MonteCarloAided, EkfStatisticsAndNeesAreBitIdenticalForThreadsAndShards) {
   for (size_t e = 0; e < one.covariance->epochs.size(); ++e) {
     EXPECT_EQ(one.covariance->epochs[e].P, three.covariance->epochs[e].P);
   }
-  // The barometer's Gauss-Markov bias is treated as white by the filter: listed.
-  ASSERT_EQ(one.covariance->unrepresented.size(), 1u);
-  EXPECT_EQ(one.covariance->unrepresented[0], "aiding.barometer.bias_gauss_markov_sigma_m");
+  // The barometer's Gauss-Markov bias is a filter state (issue 18): nothing left out.
+  EXPECT_TRUE(one.covariance->unrepresented.empty());
+  EXPECT_EQ(one.covariance->epochs[0].P.rows(), kNumErrorStates + 1);
 }
 
 // Seed 003's complementary filter on a vehicle at rest with a fixed accelerometer bias b and no

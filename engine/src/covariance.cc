@@ -13,19 +13,66 @@ ErrorCovariancePropagator::ErrorCovariancePropagator(const NavEnvironment& env,
                                                      Discretization method)
     : env_(env),
       noise_(noise),
+      layout_(noise),
       Q_c_(ErrorStateProcessNoise(noise)),
       method_(method),
-      P_(P0),
-      Phi_(ErrorStateMatrix::Identity()),
-      Q_d_(ErrorStateMatrix::Zero()) {}
+      P_(P0) {
+  if (P0.rows() != layout_.size || P0.cols() != layout_.size) {
+    throw SpecError("covariance.P0", std::to_string(P0.rows()) + " x " + std::to_string(P0.cols()),
+                    std::to_string(layout_.size) + " x " + std::to_string(layout_.size) +
+                        " (the error state of the noise model)");
+  }
+  const int m = layout_.size - kNumNavErrorStates;
+  q_s_ = Q_c_.diagonal().tail(m);
+}
 
-const ErrorStateMatrix& ErrorCovariancePropagator::Propagate(const NavState& reference,
-                                                             const Vector3d& f_ib_b, double dt_s) {
-  const ErrorStateMatrix F = ErrorStateSystemMatrix(env_, reference, f_ib_b, noise_);
-  DiscretizeErrorModel(F, Q_c_, dt_s, method_, &Phi_, &Q_d_);
-  P_ = (Phi_ * P_ * Phi_.transpose()).eval() + Q_d_;
-  P_ = 0.5 * (P_ + P_.transpose()).eval();
-  return Phi_;
+void ErrorCovariancePropagator::Propagate(const NavState& reference, const Vector3d& f_ib_b,
+                                          double dt_s, const Vector3d& omega_ib_b) {
+  const ErrorStateMatrix F = ErrorStateSystemMatrix(env_, reference, f_ib_b, noise_, omega_ib_b);
+  if (method_ == Discretization::kVanLoan) {
+    ErrorStateMatrix Phi, Q_d;
+    DiscretizeErrorModel(F, Q_c_, dt_s, method_, &Phi, &Q_d);
+    P_ = (Phi * P_ * Phi.transpose()).eval() + Q_d;
+    P_ = 0.5 * (P_ + P_.transpose()).eval();
+    return;
+  }
+  // Structured second-order step (see the header): nav block n = 9, sensor block m.
+  constexpr int n = kNumNavErrorStates;
+  const int m = layout_.size - n;
+  const auto F_nn = F.topLeftCorner(n, n);
+  const auto F_ns = F.topRightCorner(n, m);
+  const Eigen::VectorXd D = F.bottomRightCorner(m, m).diagonal();
+  const Eigen::Matrix<double, n, n> Fnn_dt = F_nn * dt_s;
+  A_ = Eigen::Matrix<double, n, n>::Identity() + Fnn_dt + 0.5 * Fnn_dt * Fnn_dt;
+  B_ = F_ns * dt_s + 0.5 * dt_s * dt_s * (F_nn * F_ns + F_ns * D.asDiagonal());
+  d_ = (Eigen::VectorXd::Ones(m) + D * dt_s + 0.5 * (D * dt_s).cwiseAbs2());
+  const Eigen::Matrix<double, n, 1> q_n = Q_c_.diagonal().head(n);
+
+  // P <- Phi P Phi^T with P = [[P_nn, P_ns], [P_ns^T, P_ss]].
+  const auto P_nn = P_.topLeftCorner(n, n);
+  const auto P_ns = P_.topRightCorner(n, m);
+  const auto P_ss = P_.bottomRightCorner(m, m);
+  BPss_ = B_ * P_ss;         // n x m
+  Pns_ = A_ * P_ns + BPss_;  // (Phi P)_ns before the diag(d) on the right
+  Pnn_ = A_ * P_nn * A_.transpose() + A_ * P_ns * B_.transpose() +
+         (A_ * P_ns * B_.transpose()).transpose() + BPss_ * B_.transpose();
+  // Q_d = dt / 2 (Phi Q_c Phi^T + Q_c), Q_c = diag(q_n, q_s).
+  const Eigen::MatrixXd BQ = B_ * q_s_.asDiagonal();  // n x m
+  const Eigen::Matrix<double, n, n> Qd_nn =
+      0.5 * dt_s *
+      (A_ * q_n.asDiagonal() * A_.transpose() + BQ * B_.transpose() +
+       Eigen::Matrix<double, n, n>(q_n.asDiagonal()));
+  const Eigen::MatrixXd Qd_ns = 0.5 * dt_s * BQ * d_.asDiagonal();
+  const Eigen::VectorXd Qd_ss = 0.5 * dt_s * (d_.cwiseAbs2().cwiseProduct(q_s_) + q_s_);
+
+  P_.topLeftCorner(n, n) = Pnn_ + Qd_nn;
+  P_.topRightCorner(n, m) = Pns_ * d_.asDiagonal();
+  P_.topRightCorner(n, m) += Qd_ns;
+  P_.bottomRightCorner(m, m) = d_.asDiagonal() * P_ss * d_.asDiagonal();
+  P_.bottomRightCorner(m, m).diagonal() += Qd_ss;
+  P_.bottomLeftCorner(m, n) = P_.topRightCorner(n, m).transpose();
+  P_.topLeftCorner(n, n) =
+      0.5 * (P_.topLeftCorner(n, n) + P_.topLeftCorner(n, n).transpose()).eval();
 }
 
 CovarianceEpoch MakeCovarianceEpoch(double t_s, const ErrorStateMatrix& P,
@@ -73,7 +120,10 @@ std::vector<CovarianceEpoch> FreeInertialCovariance(const Trajectory& trajectory
     f_n /= s * trajectory.dt_s;
     // Midpoint reference: the truth sample at k + s/2 (exact midpoint for even s).
     const NavState& mid = truth[k + s / 2];
-    prop.Propagate(mid, mid.C_b_n().transpose() * f_n, s * trajectory.dt_s);
+    Vector3d omega_b = Vector3d::Zero();
+    for (int64_t i = 0; i < s; ++i) omega_b += inc[k + i].delta_theta_ib_b;
+    omega_b /= s * trajectory.dt_s;
+    prop.Propagate(mid, mid.C_b_n().transpose() * f_n, s * trajectory.dt_s, omega_b);
     k += s;
     if (k % options.epoch_every_samples == 0 || k == n) {
       out.push_back(MakeCovarianceEpoch(truth[k].t_s, prop.P(), truth[k].euler()));

@@ -1,63 +1,206 @@
 #include "driftlab/error_state.h"
 
+#include <algorithm>
 #include <cmath>
 #include <unsupported/Eigen/MatrixFunctions>
+#include <utility>
 
 #include "driftlab/attitude.h"
+#include "driftlab/sensors.h"
 
 namespace driftlab {
 namespace {
 
-// One triad's bias as a single state per axis; appends the unrepresentable terms.
-BiasStateModel BiasModelOf(const TriadErrorParams& p, const std::string& path,
-                           std::vector<std::string>* unrepresented) {
-  BiasStateModel b;
+bool HasScaleMisalignment(const ScaleMisalignmentModel& m) {
+  return m.scale_factor_sigma > 0.0 || m.misalignment_sigma_rad > 0.0;
+}
+
+// One triad's stochastic bias processes as states; appends the left-out terms.
+void BiasModelOf(const TriadErrorParams& p, const std::string& path,
+                 const ErrorModelOptions& options, BiasStateModel* primary,
+                 std::vector<BiasStateModel>* extra, std::vector<std::string>* unrepresented) {
+  *primary = BiasStateModel{};
+  extra->clear();
+  // Turn-on bias and random walk share one state: b(0) ~ N(0, s0^2), b' = w, PSD K^2.
   const bool turn_on = p.turn_on_bias_sigma > 0.0;
-  const bool gm = p.bias_gauss_markov.sigma > 0.0;
   const bool rw = p.random_walk > 0.0;
+  const bool gm = p.bias_gauss_markov.sigma > 0.0;
+  BiasStateModel gm_state;
   if (gm) {
-    // A bias started at 0 (gnss-ins-sim's convention) has no initial uncertainty.
-    b.initial_sigma = p.bias_gauss_markov.start_at_zero ? 0.0 : p.bias_gauss_markov.sigma;
-    b.tau_s = p.bias_gauss_markov.tau_s;
-    b.driving_psd = 2.0 * p.bias_gauss_markov.sigma * p.bias_gauss_markov.sigma / b.tau_s;
-    if (turn_on) unrepresented->push_back(path + ".turn_on_bias_sigma");
-    if (rw) unrepresented->push_back(path + ".random_walk");
-  } else if (rw) {
-    b.driving_psd = p.random_walk * p.random_walk;
-    if (turn_on) unrepresented->push_back(path + ".turn_on_bias_sigma");
-  } else {
-    b.initial_sigma = p.turn_on_bias_sigma;
+    // First-order Gauss-Markov b' = -b / tau + w, PSD 2 sigma^2 / tau (Maybeck vol. 1, 4.11); a
+    // bias started at 0 (gnss-ins-sim's convention) has no initial uncertainty.
+    gm_state.initial_sigma = p.bias_gauss_markov.start_at_zero ? 0.0 : p.bias_gauss_markov.sigma;
+    gm_state.tau_s = p.bias_gauss_markov.tau_s;
+    gm_state.driving_psd =
+        2.0 * p.bias_gauss_markov.sigma * p.bias_gauss_markov.sigma / p.bias_gauss_markov.tau_s;
   }
-  if (!p.fixed_bias.isZero(0.0)) unrepresented->push_back(path + ".fixed_bias");
-  if (p.bias_flicker.bias_instability > 0.0) unrepresented->push_back(path + ".bias_flicker");
-  if (!p.scale_factor_fixed.isZero(0.0) || p.scale_factor_sigma > 0.0 ||
-      !p.scale_factor_asymmetry.isZero(0.0)) {
-    unrepresented->push_back(path + ".scale_factor");
+  BiasStateModel walk;
+  walk.initial_sigma = p.turn_on_bias_sigma;
+  walk.driving_psd = p.random_walk * p.random_walk;
+  std::vector<BiasStateModel> states;
+  if (turn_on || rw) states.push_back(walk);
+  if (gm) states.push_back(gm_state);
+  if (p.bias_flicker.bias_instability > 0.0) {
+    for (const BiasStateModel& f :
+         FitFlickerStates(p.bias_flicker, options.flicker_states_per_axis, options.time_scale_min_s,
+                          options.time_scale_max_s)) {
+      states.push_back(f);
+    }
   }
-  if (!p.misalignment_fixed.isZero(0.0) || p.misalignment_sigma_rad > 0.0) {
-    unrepresented->push_back(path + ".misalignment");
+  if (!states.empty()) {
+    *primary = states[0];
+    extra->assign(states.begin() + 1, states.end());
   }
-  if (p.quantization > 0.0) unrepresented->push_back(path + ".quantization");
-  if (p.range > 0.0) unrepresented->push_back(path + ".range (saturation, if reached)");
-  return b;
+  if (!p.fixed_bias.isZero(0.0)) {
+    unrepresented->push_back(path +
+                             ".fixed_bias (deterministic: the same error in every run, a mean "
+                             "the filter does not estimate beyond its bias states)");
+  }
+  if (!p.scale_factor_fixed.isZero(0.0) || !p.scale_factor_asymmetry.isZero(0.0)) {
+    unrepresented->push_back(path +
+                             ".scale_factor_fixed/asymmetry (deterministic: error proportional "
+                             "to the rate or specific force, the same in every run)");
+  }
+  if (!p.misalignment_fixed.isZero(0.0)) {
+    unrepresented->push_back(path +
+                             ".misalignment_fixed (deterministic: cross-axis error, the same in "
+                             "every run)");
+  }
+  if (p.quantization > 0.0) {
+    unrepresented->push_back(path +
+                             ".quantization (white to first order, variance LSB^2 / 12 per "
+                             "sample, carried remainder: bounded, negligible above 1 LSB)");
+  }
+  if (p.range > 0.0) {
+    unrepresented->push_back(path + ".range (saturation: no effect unless the motion reaches it)");
+  }
+}
+
+ScaleMisalignmentModel ScaleMisalignmentOf(const TriadErrorParams& p) {
+  return ScaleMisalignmentModel{p.scale_factor_sigma, p.misalignment_sigma_rad};
+}
+
+// Conservative white-noise bound of a triad's random scale-factor and misalignment errors when
+// they are not states. The error on axis i is e_i(t) = s_i m_i(t) + sum_{j != i} M_ij m_j(t) with
+// random constants s_i ~ N(0, sigma_s^2), M_ij ~ N(0, sigma_m^2); over any window of length
+// tau <= T its integral has variance <= (sigma_s^2 m_max,i^2 + sigma_m^2 sum_{j != i}
+// m_max,j^2) tau^2 <= q_i tau with
+//   q_i = (sigma_s^2 m_max,i^2 + sigma_m^2 sum_{j != i} m_max,j^2) T,
+// the variance a white noise of PSD q_i adds over tau. So white noise of PSD max_i q_i (isotropic,
+// as the error model's white terms) bounds the integrated error's variance over every unaided
+// stretch up to T (the longest interval without aiding).
+double ScaleMisalignmentWhiteBound(const ScaleMisalignmentModel& m, const Vector3d& max_abs_b,
+                                   double T_s) {
+  double q = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    double cross = 0.0;
+    for (int j = 0; j < 3; ++j) {
+      if (j != i) cross += max_abs_b[j] * max_abs_b[j];
+    }
+    q = std::max(q, m.scale_factor_sigma * m.scale_factor_sigma * max_abs_b[i] * max_abs_b[i] +
+                        m.misalignment_sigma_rad * m.misalignment_sigma_rad * cross);
+  }
+  return q * T_s;
 }
 
 }  // namespace
 
-ErrorStateNoiseFromImu MakeErrorStateNoise(const ImuErrorModel& model, const std::string& path) {
+ErrorStateLayout::ErrorStateLayout(const ErrorStateNoise& noise) {
+  int next = kNumErrorStates;
+  auto take = [&next](int count) {
+    const int first = next;
+    next += count;
+    return first;
+  };
+  for (size_t i = 0; i < noise.accel_bias_extra.size(); ++i) accel_bias_extra.push_back(take(3));
+  for (size_t i = 0; i < noise.gyro_bias_extra.size(); ++i) gyro_bias_extra.push_back(take(3));
+  if (HasScaleMisalignment(noise.gyro_scale_misalignment)) {
+    gyro_scale = take(3);
+    gyro_misalignment = take(6);
+  }
+  if (HasScaleMisalignment(noise.accel_scale_misalignment)) {
+    accel_scale = take(3);
+    accel_misalignment = take(6);
+  }
+  if (!noise.gnss_position_gm_sigma_ned_m.isZero(0.0)) gnss_position = take(3);
+  if (noise.barometer_bias_sigma_m > 0.0) barometer_bias = take(1);
+  size = next;
+}
+
+std::vector<BiasStateModel> FitFlickerStates(const FlickerParams& flicker, int count,
+                                             double t_min_s, double t_max_s) {
+  const std::vector<GaussMarkovComponent> design = DesignFlickerApproximation(flicker);
+  std::vector<BiasStateModel> out;
+  auto gm = [](double variance, double tau_s) {
+    BiasStateModel b;
+    b.initial_sigma = std::sqrt(variance);  // the simulator starts flicker stationary
+    b.tau_s = tau_s;
+    b.driving_psd = 2.0 * variance / tau_s;
+    return b;
+  };
+  if (design.empty()) return out;
+  if (count >= static_cast<int>(design.size())) {
+    for (const GaussMarkovComponent& c : design) out.push_back(gm(c.sigma * c.sigma, c.tau_s));
+    return out;
+  }
+  count = std::max(count, 1);
+  const double lo = std::log(std::max(t_min_s, 1e-6));
+  const double hi = std::log(std::max(t_max_s, std::max(t_min_s, 1e-6) * 1.0001));
+  std::vector<double> variance(static_cast<size_t>(count), 0.0);
+  std::vector<double> log_tau_sum(static_cast<size_t>(count), 0.0);
+  for (const GaussMarkovComponent& c : design) {
+    const double x = (std::log(c.tau_s) - lo) / (hi - lo) * count;
+    const int g = std::clamp(static_cast<int>(std::floor(x)), 0, count - 1);
+    variance[g] += c.sigma * c.sigma;
+    log_tau_sum[g] += c.sigma * c.sigma * std::log(c.tau_s);
+  }
+  for (int g = 0; g < count; ++g) {
+    if (variance[g] > 0.0) out.push_back(gm(variance[g], std::exp(log_tau_sum[g] / variance[g])));
+  }
+  return out;
+}
+
+ErrorStateNoiseFromImu MakeErrorStateNoise(const ImuErrorModel& model, const std::string& path,
+                                           const ErrorModelOptions& options) {
   ErrorStateNoiseFromImu out;
-  out.noise.gyro_white_psd = model.gyro.white_noise_density * model.gyro.white_noise_density;
-  out.noise.accel_white_psd = model.accel.white_noise_density * model.accel.white_noise_density;
-  out.noise.gyro_bias = BiasModelOf(model.gyro, path + ".gyro", &out.unrepresented);
-  out.noise.accel_bias = BiasModelOf(model.accel, path + ".accel", &out.unrepresented);
+  ErrorStateNoise& n = out.noise;
+  n.gyro_white_psd = model.gyro.white_noise_density * model.gyro.white_noise_density;
+  n.accel_white_psd = model.accel.white_noise_density * model.accel.white_noise_density;
+  BiasModelOf(model.gyro, path + ".gyro", options, &n.gyro_bias, &n.gyro_bias_extra,
+              &out.unrepresented);
+  BiasModelOf(model.accel, path + ".accel", options, &n.accel_bias, &n.accel_bias_extra,
+              &out.unrepresented);
+  const ScaleMisalignmentModel gyro_sm = ScaleMisalignmentOf(model.gyro);
+  const ScaleMisalignmentModel accel_sm = ScaleMisalignmentOf(model.accel);
+  if (options.augment_scale_misalignment) {
+    n.gyro_scale_misalignment = gyro_sm;
+    n.accel_scale_misalignment = accel_sm;
+  } else {
+    const double T = options.unaided_interval_s;
+    n.gyro_white_psd += ScaleMisalignmentWhiteBound(gyro_sm, options.max_abs_omega_ib_b, T);
+    n.accel_white_psd += ScaleMisalignmentWhiteBound(accel_sm, options.max_abs_f_ib_b, T);
+    for (const auto& [sm, name] : {std::pair{gyro_sm, ".gyro"}, std::pair{accel_sm, ".accel"}}) {
+      if (HasScaleMisalignment(sm)) {
+        out.unrepresented.push_back(
+            path + name + ".scale_factor/misalignment (as a white-noise bound over " +
+            std::to_string(T) +
+            " s, filter.augment_scale_misalignment = false: conservative, NEES below its band)");
+      }
+    }
+  }
   if (!model.gyro_g_sensitivity.isZero(0.0)) {
-    out.unrepresented.push_back(path + ".gyro_g_sensitivity");
+    out.unrepresented.push_back(path +
+                                ".gyro_g_sensitivity (deterministic: rate error G f, the same in "
+                                "every run; about G g while level, absorbed by the gyro bias "
+                                "states while aided)");
   }
   return out;
 }
 
 ErrorStateMatrix ErrorStateSystemMatrix(const NavEnvironment& env, const NavState& reference,
-                                        const Vector3d& f_ib_b, const ErrorStateNoise& noise) {
+                                        const Vector3d& f_ib_b, const ErrorStateNoise& noise,
+                                        const Vector3d& omega_ib_b) {
+  const ErrorStateLayout layout(noise);
   const double L = reference.llh.lat_rad;
   const double h = reference.llh.h_m;
   const Vector3d& v = reference.v_eb_n;
@@ -89,7 +232,7 @@ ErrorStateMatrix ErrorStateSystemMatrix(const NavEnvironment& env, const NavStat
     Wen_r(2, 2) = -v.y() * tanL / (RE * RE);
   }
 
-  ErrorStateMatrix F = ErrorStateMatrix::Zero();
+  ErrorStateMatrix F = ErrorStateMatrix::Zero(layout.size, layout.size);
   // Attitude: psi' = -omega_in x psi + C_b_n b_g - d(omega_in).
   F.block<3, 3>(kErrAttitude, kErrAttitude) = -Skew(omega_ie_n + omega_en_n);
   F.block<3, 3>(kErrAttitude, kErrVelocity) = -Wen_v;
@@ -113,43 +256,88 @@ ErrorStateMatrix ErrorStateSystemMatrix(const NavEnvironment& env, const NavStat
     F(1, 1) += -v.z() / RE - v.x() * tanL / RN;
     F(1, 2) += v.y() / RE;
   }
-  // Biases.
-  if (noise.accel_bias.tau_s > 0.0) {
-    F.block<3, 3>(kErrAccelBias, kErrAccelBias) = -Matrix3d::Identity() / noise.accel_bias.tau_s;
+  // Biases: b' = -b / tau (Gauss-Markov) or 0.
+  auto bias_block = [&](int first, int nav_rows, const BiasStateModel& b) {
+    F.block<3, 3>(nav_rows, first) = C_b_n;
+    if (b.tau_s > 0.0) F.block<3, 3>(first, first) = -Matrix3d::Identity() / b.tau_s;
+  };
+  bias_block(kErrAccelBias, kErrVelocity, noise.accel_bias);
+  bias_block(kErrGyroBias, kErrAttitude, noise.gyro_bias);
+  for (size_t i = 0; i < layout.accel_bias_extra.size(); ++i) {
+    bias_block(layout.accel_bias_extra[i], kErrVelocity, noise.accel_bias_extra[i]);
   }
-  if (noise.gyro_bias.tau_s > 0.0) {
-    F.block<3, 3>(kErrGyroBias, kErrGyroBias) = -Matrix3d::Identity() / noise.gyro_bias.tau_s;
+  for (size_t i = 0; i < layout.gyro_bias_extra.size(); ++i) {
+    bias_block(layout.gyro_bias_extra[i], kErrAttitude, noise.gyro_bias_extra[i]);
+  }
+  // Scale factor / misalignment (random constants): d(error of m) / d s_i = m_i e_i,
+  // d / d M_ij = m_j e_i, resolved in n by C_b_n (Groves 2nd ed. (4.17), (14.98)).
+  auto sm_block = [&](int scale, int mis, int nav_rows, const Vector3d& m_b) {
+    if (scale < 0) return;
+    for (int i = 0; i < 3; ++i) F.block<3, 1>(nav_rows, scale + i) = C_b_n.col(i) * m_b[i];
+    for (int k = 0; k < 6; ++k) {
+      F.block<3, 1>(nav_rows, mis + k) = C_b_n.col(kMisalignmentRow[k]) * m_b[kMisalignmentCol[k]];
+    }
+  };
+  sm_block(layout.gyro_scale, layout.gyro_misalignment, kErrAttitude, omega_ib_b);
+  sm_block(layout.accel_scale, layout.accel_misalignment, kErrVelocity, f_ib_b);
+  // Aiding Gauss-Markov errors: e' = -e / tau.
+  if (layout.gnss_position >= 0) {
+    F.block<3, 3>(layout.gnss_position, layout.gnss_position) =
+        -Matrix3d::Identity() / noise.gnss_position_gm_tau_s;
+  }
+  if (layout.barometer_bias >= 0) {
+    F(layout.barometer_bias, layout.barometer_bias) = -1.0 / noise.barometer_bias_tau_s;
   }
   return F;
 }
 
 ErrorStateMatrix ErrorStateProcessNoise(const ErrorStateNoise& noise) {
-  ErrorStateMatrix Q = ErrorStateMatrix::Zero();
-  for (int i = 0; i < 3; ++i) {
-    Q(kErrVelocity + i, kErrVelocity + i) = noise.accel_white_psd;
-    Q(kErrAttitude + i, kErrAttitude + i) = noise.gyro_white_psd;
-    Q(kErrAccelBias + i, kErrAccelBias + i) = noise.accel_bias.driving_psd;
-    Q(kErrGyroBias + i, kErrGyroBias + i) = noise.gyro_bias.driving_psd;
+  const ErrorStateLayout layout(noise);
+  ErrorStateMatrix Q = ErrorStateMatrix::Zero(layout.size, layout.size);
+  auto diag3 = [&Q](int first, double q) {
+    for (int i = 0; i < 3; ++i) Q(first + i, first + i) = q;
+  };
+  diag3(kErrVelocity, noise.accel_white_psd);
+  diag3(kErrAttitude, noise.gyro_white_psd);
+  diag3(kErrAccelBias, noise.accel_bias.driving_psd);
+  diag3(kErrGyroBias, noise.gyro_bias.driving_psd);
+  for (size_t i = 0; i < layout.accel_bias_extra.size(); ++i) {
+    diag3(layout.accel_bias_extra[i], noise.accel_bias_extra[i].driving_psd);
+  }
+  for (size_t i = 0; i < layout.gyro_bias_extra.size(); ++i) {
+    diag3(layout.gyro_bias_extra[i], noise.gyro_bias_extra[i].driving_psd);
+  }
+  // Gauss-Markov aiding errors: PSD 2 sigma^2 / tau (stationary variance sigma^2).
+  if (layout.gnss_position >= 0) {
+    for (int i = 0; i < 3; ++i) {
+      const double s = noise.gnss_position_gm_sigma_ned_m[i];
+      Q(layout.gnss_position + i, layout.gnss_position + i) =
+          2.0 * s * s / noise.gnss_position_gm_tau_s;
+    }
+  }
+  if (layout.barometer_bias >= 0) {
+    const double s = noise.barometer_bias_sigma_m;
+    Q(layout.barometer_bias, layout.barometer_bias) = 2.0 * s * s / noise.barometer_bias_tau_s;
   }
   return Q;
 }
 
 void DiscretizeErrorModel(const ErrorStateMatrix& F, const ErrorStateMatrix& Q_c, double dt_s,
                           Discretization method, ErrorStateMatrix* Phi, ErrorStateMatrix* Q_d) {
-  constexpr int n = kNumErrorStates;
+  const Eigen::Index n = F.rows();
   if (method == Discretization::kVanLoan) {
-    Eigen::Matrix<double, 2 * n, 2 * n> A = Eigen::Matrix<double, 2 * n, 2 * n>::Zero();
-    A.topLeftCorner<n, n>() = -F * dt_s;
-    A.topRightCorner<n, n>() = Q_c * dt_s;
-    A.bottomRightCorner<n, n>() = F.transpose() * dt_s;
-    const Eigen::Matrix<double, 2 * n, 2 * n> B = A.exp();
-    *Phi = B.bottomRightCorner<n, n>().transpose();
-    *Q_d = *Phi * B.topRightCorner<n, n>();
+    Eigen::MatrixXd A = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+    A.topLeftCorner(n, n) = -F * dt_s;
+    A.topRightCorner(n, n) = Q_c * dt_s;
+    A.bottomRightCorner(n, n) = F.transpose() * dt_s;
+    const Eigen::MatrixXd B = A.exp();
+    *Phi = B.bottomRightCorner(n, n).transpose();
+    *Q_d = *Phi * B.topRightCorner(n, n);
     *Q_d = 0.5 * (*Q_d + Q_d->transpose()).eval();
     return;
   }
   const ErrorStateMatrix Fdt = F * dt_s;
-  *Phi = ErrorStateMatrix::Identity() + Fdt + 0.5 * Fdt * Fdt;
+  *Phi = ErrorStateMatrix::Identity(n, n) + Fdt + 0.5 * Fdt * Fdt;
   *Q_d = 0.5 * dt_s * (*Phi * Q_c * Phi->transpose() + Q_c);
 }
 
@@ -167,15 +355,38 @@ ErrorStateMatrix InitialErrorCovariance(const Vector3d& position_sigma_ned_m,
                                         const Vector3d& velocity_sigma_ned_m_per_s,
                                         const Vector3d& euler_sigma_rad,
                                         const EulerAngles& attitude, const ErrorStateNoise& noise) {
-  ErrorStateMatrix P = ErrorStateMatrix::Zero();
+  const ErrorStateLayout layout(noise);
+  ErrorStateMatrix P = ErrorStateMatrix::Zero(layout.size, layout.size);
   P.block<3, 3>(kErrPosition, kErrPosition) = position_sigma_ned_m.cwiseAbs2().asDiagonal();
   P.block<3, 3>(kErrVelocity, kErrVelocity) = velocity_sigma_ned_m_per_s.cwiseAbs2().asDiagonal();
   const Matrix3d E = EulerErrorFromAttitudeError(attitude).inverse();
   P.block<3, 3>(kErrAttitude, kErrAttitude) =
       E * euler_sigma_rad.cwiseAbs2().asDiagonal() * E.transpose();
-  const double sa = noise.accel_bias.initial_sigma, sg = noise.gyro_bias.initial_sigma;
-  P.block<3, 3>(kErrAccelBias, kErrAccelBias) = sa * sa * Matrix3d::Identity();
-  P.block<3, 3>(kErrGyroBias, kErrGyroBias) = sg * sg * Matrix3d::Identity();
+  auto diag = [&P](int first, int count, double sigma) {
+    for (int i = 0; i < count; ++i) P(first + i, first + i) = sigma * sigma;
+  };
+  diag(kErrAccelBias, 3, noise.accel_bias.initial_sigma);
+  diag(kErrGyroBias, 3, noise.gyro_bias.initial_sigma);
+  for (size_t i = 0; i < layout.accel_bias_extra.size(); ++i) {
+    diag(layout.accel_bias_extra[i], 3, noise.accel_bias_extra[i].initial_sigma);
+  }
+  for (size_t i = 0; i < layout.gyro_bias_extra.size(); ++i) {
+    diag(layout.gyro_bias_extra[i], 3, noise.gyro_bias_extra[i].initial_sigma);
+  }
+  if (layout.gyro_scale >= 0) {
+    diag(layout.gyro_scale, 3, noise.gyro_scale_misalignment.scale_factor_sigma);
+    diag(layout.gyro_misalignment, 6, noise.gyro_scale_misalignment.misalignment_sigma_rad);
+  }
+  if (layout.accel_scale >= 0) {
+    diag(layout.accel_scale, 3, noise.accel_scale_misalignment.scale_factor_sigma);
+    diag(layout.accel_misalignment, 6, noise.accel_scale_misalignment.misalignment_sigma_rad);
+  }
+  if (layout.gnss_position >= 0) {
+    for (int i = 0; i < 3; ++i) {
+      diag(layout.gnss_position + i, 1, noise.gnss_position_gm_sigma_ned_m[i]);
+    }
+  }
+  if (layout.barometer_bias >= 0) diag(layout.barometer_bias, 1, noise.barometer_bias_sigma_m);
   return P;
 }
 

@@ -93,7 +93,7 @@ struct SharedTruth {
   std::vector<int64_t> zupt_epochs;
   // kInsGnssEkf: the filter's noise model and initial covariance.
   ErrorStateNoise ekf_noise;
-  ErrorStateMatrix ekf_P0 = ErrorStateMatrix::Zero();
+  ErrorStateMatrix ekf_P0;
 };
 
 // Converts requested times into ascending sample indices in [first_k, n].
@@ -161,6 +161,21 @@ void ValidateFilter(const MonteCarloSpec& spec) {
   only_with(a.barometer.has_value(), "aiding.barometer", "INS_GNSS_EKF");
   only_with(a.zupt.has_value(), "aiding.zupt", "INS_GNSS_EKF");
   only_with(a.magnetometer.has_value(), "aiding.magnetometer", "COMPLEMENTARY");
+  if (spec.filter_flicker_states_per_axis < 1 ||
+      spec.filter_flicker_states_per_axis > kMaxFlickerComponents) {
+    throw SpecError("navigation.ekf.flicker_states_per_axis",
+                    std::to_string(spec.filter_flicker_states_per_axis),
+                    "[1, " + std::to_string(kMaxFlickerComponents) + "]");
+  }
+  if (spec.filter_sensor) {
+    if (f != NavigationFilterKind::kInsGnssEkf && !spec.covariance) {
+      throw SpecError("navigation.ekf.sensor", "set",
+                      "only with navigation.filter INS_GNSS_EKF or the covariance analysis (the "
+                      "filter is " +
+                          name + ")");
+    }
+    ValidateImuErrorModel(*spec.filter_sensor, "navigation.ekf.sensor");
+  }
   if (f == NavigationFilterKind::kInsGnssEkf) {
     if (!a.gnss && !a.barometer && !a.zupt) {
       throw SpecError("navigation.filter", name,
@@ -812,6 +827,57 @@ bool RunSeed000(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, 
   return true;
 }
 
+// The error-state model the EKF and the covariance analysis use (MakeErrorStateNoise of the
+// filter's IMU model, spec.filter_sensor or else the truth's), with the GNSS and barometer
+// Gauss-Markov errors as states for the EKF, and the run's time scales and motion bounds.
+ErrorStateNoiseFromImu FilterErrorModel(const MonteCarloSpec& spec, const SharedTruth& s) {
+  const bool ekf = spec.filter == NavigationFilterKind::kInsGnssEkf;
+  const double duration_s = static_cast<double>(s.n - s.start_step) * s.dt_s;
+  ErrorModelOptions options;
+  options.augment_scale_misalignment = spec.filter_augment_scale_misalignment;
+  options.flicker_states_per_axis = spec.filter_flicker_states_per_axis;
+  // The run's time scales: from the shortest aiding interval (or the IMU interval) to its length.
+  double aid_interval_s = 0.0;
+  double unaided_s = duration_s;
+  if (ekf && spec.aiding.gnss) {
+    aid_interval_s = 1.0 / spec.aiding.gnss->rate_hz;
+    unaided_s = aid_interval_s;
+    for (const GnssOutage& o : spec.aiding.gnss->outages)
+      unaided_s = std::max(unaided_s, o.duration_s);
+  }
+  options.time_scale_min_s = std::max(aid_interval_s, s.dt_s);
+  options.time_scale_max_s = std::max(duration_s, options.time_scale_min_s);
+  options.unaided_interval_s = unaided_s;
+  for (size_t k = 1; k < s.increments.size(); ++k) {
+    options.max_abs_omega_ib_b =
+        options.max_abs_omega_ib_b.cwiseMax(s.increments[k].delta_theta_ib_b.cwiseAbs() / s.dt_s);
+    options.max_abs_f_ib_b =
+        options.max_abs_f_ib_b.cwiseMax(s.increments[k].delta_v_ib_b.cwiseAbs() / s.dt_s);
+  }
+  ErrorStateNoiseFromImu out;
+  const std::optional<ImuErrorModel>& model = spec.filter_sensor ? spec.filter_sensor : spec.sensor;
+  if (model) {
+    out = MakeErrorStateNoise(*model, spec.filter_sensor ? "navigation.ekf.sensor" : "sensor",
+                              options);
+  }
+  if (spec.filter_sensor) {
+    static const std::string kMistuned =
+        "navigation.ekf.sensor (the filter assumes this model, not the truth's sensor: the "
+        "predicted sigma "
+        "is the filter's belief, a mistuning shows as NEES outside its band)";
+    out.unrepresented.push_back(kMistuned);
+  }
+  if (ekf && spec.aiding.gnss && !spec.aiding.gnss->position_gauss_markov_sigma_ned_m.isZero(0.0)) {
+    out.noise.gnss_position_gm_sigma_ned_m = spec.aiding.gnss->position_gauss_markov_sigma_ned_m;
+    out.noise.gnss_position_gm_tau_s = spec.aiding.gnss->position_gauss_markov_tau_s;
+  }
+  if (ekf && spec.aiding.barometer && spec.aiding.barometer->bias.sigma > 0.0) {
+    out.noise.barometer_bias_sigma_m = spec.aiding.barometer->bias.sigma;
+    out.noise.barometer_bias_tau_s = spec.aiding.barometer->bias.tau_s;
+  }
+  return out;
+}
+
 // Per-thread NEES sums of a kInsGnssEkf job (FilterConsistencyData), indexed by epoch.
 struct NeesAccumulator {
   std::vector<ExactSum> sum;
@@ -845,7 +911,10 @@ bool RunEkf(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, cons
   double baro_sigma_m = 0.0;
   if (aiding.barometer) {
     baro.emplace(*aiding.barometer, s.rate_hz, spec.seed, run);
-    baro_sigma_m = std::hypot(aiding.barometer->noise_sigma_m, aiding.barometer->bias.sigma);
+    // The bias is a filter state when the filter's model has it; otherwise it widens R.
+    baro_sigma_m = s.ekf_noise.barometer_bias_sigma_m > 0.0
+                       ? aiding.barometer->noise_sigma_m
+                       : std::hypot(aiding.barometer->noise_sigma_m, aiding.barometer->bias.sigma);
   }
   std::optional<ZuptSimulator> zupt;
   if (aiding.zupt) zupt.emplace(*aiding.zupt, s.rate_hz, spec.seed, run);
@@ -1048,9 +1117,9 @@ MonteCarloOutput RunMonteCarloWithAnalysis(
   }
   const bool ekf = spec.filter == NavigationFilterKind::kInsGnssEkf;
   const bool complementary = spec.filter == NavigationFilterKind::kComplementary;
-  // The error-state model of the sensor (no sensor: no process noise, no bias uncertainty).
-  ErrorStateNoiseFromImu noise;
-  if (spec.sensor) noise = MakeErrorStateNoise(*spec.sensor);
+  // The error-state model the filter and the analysis assume (no sensor: no process noise, no
+  // bias uncertainty).
+  const ErrorStateNoiseFromImu noise = FilterErrorModel(spec, shared);
   if (ekf || spec.covariance) {
     shared.ekf_noise = noise.noise;
     shared.ekf_P0 = InitialErrorCovariance(
@@ -1176,12 +1245,6 @@ MonteCarloOutput RunMonteCarloWithAnalysis(
     analysis.filter = spec.filter;
     analysis.step_samples = ekf ? spec.ekf_propagation_step_samples : spec.covariance_step_samples;
     analysis.unrepresented = noise.unrepresented;
-    if (ekf && spec.aiding.gnss && !spec.aiding.gnss->position_gauss_markov_sigma_ned_m.isZero()) {
-      analysis.unrepresented.push_back("aiding.gnss.position_gauss_markov_sigma_ned_m");
-    }
-    if (ekf && spec.aiding.barometer && spec.aiding.barometer->bias.sigma > 0.0) {
-      analysis.unrepresented.push_back("aiding.barometer.bias_gauss_markov_sigma_m");
-    }
     // The EKF's analysis uses its propagation interval and discretisation, so that it predicts
     // that filter; the free INS's uses covariance_step_samples with Van Loan's exact transition.
     analysis.epochs = FilterCovarianceAnalysis(

@@ -81,7 +81,7 @@ inline std::vector<Epoch> RunFilter(const Trajectory& t, const ImuErrorModel& mo
   const ErrorStateMatrix P0 =
       InitialErrorCovariance(sigma_r, sigma_v, sigma_att, t.truth[0].euler(), noise);
   // Initial error, psi drawn with P0's attitude block (Cholesky).
-  ErrorStateVector w;
+  ErrorStateVector w(kNumErrorStates);
   for (int i = 0; i < 9; ++i) {
     w[i] = RandomStream(seed, run,
                         {SensorId::kInitialConditions, static_cast<uint8_t>(i % 3),
@@ -112,7 +112,7 @@ inline std::vector<Epoch> RunFilter(const Trajectory& t, const ImuErrorModel& mo
     if (k % every == 0) {
       filter.SyncCovariance();
       const NavError err = ComputeNavError(t.environment, filter.state(), t.truth[k]);
-      ErrorStateVector x;
+      ErrorStateVector x = ErrorStateVector::Zero(kNumErrorStates);
       x.segment<3>(kErrPosition) = err.r_ned_m;
       x.segment<3>(kErrVelocity) = err.v_ned_m_per_s;
       x.segment<3>(kErrAttitude) = err.psi_nb_n_rad;

@@ -16,6 +16,7 @@
 #include "driftlab/ins_gnss_filter.h"
 #include "driftlab/jobspec/sensor_model.h"
 #include "driftlab/jobspec/translate.h"
+#include "driftlab/sensors.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/trajectory.h"
 #include "field_checks.h"
@@ -218,6 +219,15 @@ void TranslateFilterAndAiding(const v1::Job& job, const MonteCarloOverrides& ove
   spec->ekf_propagation_step_samples = static_cast<int64_t>(OptionalOr(
       "navigation.ekf.propagation_step_samples", nav.ekf().has_propagation_step_samples(),
       nav.ekf().propagation_step_samples(), 10.0, Closed(1.0, 10000.0, "samples")));
+  if (nav.ekf().has_sensor() && nav.ekf().sensor().ByteSizeLong() > 0) {
+    spec->filter_sensor = ToImuErrorModel(nav.ekf().sensor(), "navigation.ekf.sensor");
+  }
+  spec->filter_augment_scale_misalignment =
+      !nav.ekf().has_augment_scale_misalignment() || nav.ekf().augment_scale_misalignment();
+  spec->filter_flicker_states_per_axis = static_cast<int>(
+      OptionalOr("navigation.ekf.flicker_states_per_axis", nav.ekf().has_flicker_states_per_axis(),
+                 nav.ekf().flicker_states_per_axis(), static_cast<double>(kMaxFlickerComponents),
+                 Closed(1.0, static_cast<double>(kMaxFlickerComponents), "states")));
   const v1::ComplementaryOptions& c = nav.complementary();
   switch (c.pair()) {
     case v1::ComplementaryOptions::PAIR_UNSPECIFIED:

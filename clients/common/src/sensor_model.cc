@@ -212,7 +212,10 @@ bool IsEmpty(const v1::SensorModel& sensor) { return sensor.ByteSizeLong() == 0;
 
 std::optional<ImuErrorModel> ToImuErrorModel(const v1::Job& job) {
   if (!job.has_sensor() || IsEmpty(job.sensor())) return std::nullopt;
-  const v1::SensorModel& in = job.sensor();
+  return ToImuErrorModel(job.sensor(), "sensor");
+}
+
+ImuErrorModel ToImuErrorModel(const v1::SensorModel& in, const std::string& prefix) {
   ImuErrorModel model;
   if (!in.preset().empty()) {
     model = FindImuPreset(in.preset());  // SpecError "sensor.preset: ... allowed: one of ..."
@@ -220,13 +223,13 @@ std::optional<ImuErrorModel> ToImuErrorModel(const v1::Job& job) {
     model.name = "custom";
     model.description = "explicit parameters from the job file";
   }
-  ApplyTriad(in.gyro(), kGyroUnits, "sensor.gyro", &model.gyro);
-  ApplyTriad(in.accel(), kAccelUnits, "sensor.accel", &model.accel);
+  ApplyTriad(in.gyro(), kGyroUnits, prefix + ".gyro", &model.gyro);
+  ApplyTriad(in.accel(), kAccelUnits, prefix + ".accel", &model.accel);
 
   // g-sensitivity [deg/h/g]: 3 values (diagonal) or 9 (row order).
   const auto& g_sensitivity = in.gyro().g_sensitivity_deg_per_h_per_g();
   if (!g_sensitivity.empty()) {
-    const std::string path = "sensor.gyro.g_sensitivity_deg_per_h_per_g";
+    const std::string path = prefix + ".gyro.g_sensitivity_deg_per_h_per_g";
     if (g_sensitivity.size() != 3 && g_sensitivity.size() != 9) {
       throw SpecError(path, fmt::format("{} values", g_sensitivity.size()),
                       "3 values (diagonal) or 9 (row order)");
@@ -247,7 +250,7 @@ std::optional<ImuErrorModel> ToImuErrorModel(const v1::Job& job) {
       }
     }
   }
-  ValidateImuErrorModel(model, "sensor");  // the engine's own checks, as a last line
+  ValidateImuErrorModel(model, prefix);  // the engine's own checks, as a last line
   return model;
 }
 

@@ -1,26 +1,33 @@
 // Loosely coupled INS/GNSS error-state Kalman filter on mechanization A (Groves 2nd ed., sections
 // 14.1-14.2 and 14.3.1; closed-loop correction, section 14.1.1):
 //   * the NED mechanization (ins.h) integrates the IMU increments corrected by the estimated
-//     biases: delta_theta - b_g dt, delta_v - b_a dt;
-//   * the 15-state error covariance (error_state.h) is propagated along the estimated trajectory,
+//     biases (the sum of the bias states' estimates) and, when augmented, the estimated scale
+//     factor and misalignment: (I - S^ - M^) (delta_theta - b^_g dt), likewise delta_v (first
+//     order inverse of m~ = (I + S + M) m + b);
+//   * between fixes each Gauss-Markov state's estimate decays as its conditional mean,
+//     b^ <- exp(-T / tau) b^ (Maybeck vol. 1, 4.11);
+//   * the error covariance (error_state.h; 15 core states plus the augmented ones of the noise
+//     model) is propagated along the estimated trajectory,
 //     P <- Phi P Phi^T + Q_d, every propagation_step_samples samples (and before each update);
 //   * at a GNSS fix the innovation z = (estimated antenna position - fix) [m, NED] and
 //     (estimated antenna velocity - fix) [m/s], with
 //       H_r = [I, 0, -[(C_b_n l_b) x], 0, 0],
 //       H_v = [0, I, -[(C_b_n (omega_ib_b x l_b)) x], 0, -C_b_n [l_b x]]     (Groves
 //       section 14.3.1)
-//     (signs for x = estimate - truth), R = diag(white^2 + Gauss-Markov^2) (the correlated GNSS
-//     error is treated as white: it is not a state), K = P H^T (H P H^T + R)^-1,
+//     (signs for x = estimate - truth), with the GNSS Gauss-Markov error a state when the noise
+//     model has one (the fix corrected by its estimate e^; H = -I on x_e = e - e^; R = white^2),
+//     K = P H^T (H P H^T + R)^-1,
 //     P <- (I - K H) P (I - K H)^T + K R K^T (Joseph form);
-//   * barometer (UpdateHeight): z = h_baro - h^ = dr_D + noise (x = estimate - truth, dr_D = -dh),
-//     H = [0 0 1 | 0 ...], R = noise^2 + bias^2 (the barometer's Gauss-Markov bias is treated as
-//     white, like the GNSS correlated error);
+//   * barometer (UpdateHeight): z = (h_baro - b^) - h^ = dr_D + x_b + noise (x = estimate - truth,
+//     dr_D = -dh; x_b = b - b^ the barometer bias state when the noise model has one),
+//     H = [0 0 1 | 0 ... | 1], R = noise^2;
 //   * zero velocity (UpdateZeroVelocity, Groves section 15.3.1): z = v^_eb_n - v_measured (0 plus
 //     the residual motion), H = [0, I, 0, 0, 0], R = sigma^2 I;
 //   * closed loop: the estimated error x = K z is removed from the navigation state at once
 //     (position and velocity subtracted, attitude C_b_n <- exp(-[psi x]) C_b_n) and added to the
-//     bias estimates, then x = 0. The mechanization restarts from the corrected state, so its
-//     first step after a fix uses single-sample coning/sculling (O(dt^2) per fix).
+//     sensor-error estimates (biases, scale factor, misalignment, aiding errors), then x = 0. The
+//     mechanization restarts from the corrected state, so its first step after a fix uses
+//     single-sample coning/sculling (O(dt^2) per fix).
 // The bias states are the residual errors of the corrected measurements: x_ba = b_a - b^_a,
 // x_bg = b_g - b^_g (the corrected specific force minus the true one).
 #pragma once
@@ -55,8 +62,8 @@ class InsGnssFilter {
   // GNSS update with a fix taken at the current time; omega_ib_b is the measured body rate (for
   // the lever-arm velocity).
   void Update(const GnssMeasurement& fix, const Vector3d& omega_ib_b);
-  // Barometric height h_m [m] with its 1-sigma sigma_m (noise and bias together) at the current
-  // time.
+  // Barometric height h_m [m] with its white-noise 1-sigma sigma_m at the current time (the bias
+  // is a state when the noise model has one; otherwise sigma_m should hold the bias too).
   void UpdateHeight(double h_m, double sigma_m);
   // Zero-velocity measurement v_measured_n (0 plus the standing vehicle's residual motion) with
   // 1-sigma sigma_m_per_s per axis at the current time.
@@ -66,8 +73,9 @@ class InsGnssFilter {
 
   const NavState& state() const { return ins_.state(); }
   const ErrorStateMatrix& P() const { return propagator_.P(); }
-  const Vector3d& accel_bias() const { return accel_bias_; }  // b^_a [m/s^2]
-  const Vector3d& gyro_bias() const { return gyro_bias_; }    // b^_g [rad/s]
+  const Vector3d& accel_bias() const { return accel_bias_; }  // b^_a [m/s^2], all components
+  const Vector3d& gyro_bias() const { return gyro_bias_; }    // b^_g [rad/s], all components
+  const ErrorStateLayout& layout() const { return propagator_.layout(); }
   const InsGnssFilterOptions& options() const { return options_; }
   // Normalised innovation squared z^T S^-1 z of the last update and its dimension (3 or 6).
   double last_nis() const { return last_nis_; }
@@ -76,8 +84,10 @@ class InsGnssFilter {
  private:
   // Kalman update with innovation z (estimate minus measurement), then the closed-loop correction.
   template <int M>
-  void Correct(const Eigen::Matrix<double, M, kNumErrorStates>& H,
+  void Correct(const Eigen::Matrix<double, M, Eigen::Dynamic>& H,
                const Eigen::Matrix<double, M, M>& R, const Eigen::Matrix<double, M, 1>& z);
+  // Sums the bias estimates and builds I - S^ - M^ from sensor_estimate_.
+  void RefreshCorrections();
 
   NavEnvironment env_;
   double dt_s_;
@@ -86,7 +96,14 @@ class InsGnssFilter {
   ErrorCovariancePropagator propagator_;
   Vector3d accel_bias_ = Vector3d::Zero();
   Vector3d gyro_bias_ = Vector3d::Zero();
+  Matrix3d gyro_correction_ = Matrix3d::Identity();   // I - S^_g - M^_g
+  Matrix3d accel_correction_ = Matrix3d::Identity();  // I - S^_a - M^_a
+  // Estimates of the sensor and aiding error states (indices 9.. of the error state, minus 9),
+  // and 1 / tau of each (0 for constants and random walks).
+  Eigen::VectorXd sensor_estimate_;
+  Eigen::VectorXd inverse_tau_;
   Vector3d f_n_sum_ = Vector3d::Zero();  // sum of C_b_n delta_v since the last propagation
+  Vector3d theta_sum_ = Vector3d::Zero();  // sum of corrected delta_theta since then
   int64_t pending_ = 0;                  // samples since the last propagation
   double last_nis_ = 0.0;
   int last_dim_ = 0;
@@ -95,15 +112,18 @@ class InsGnssFilter {
 // The GNSS measurement model of the filter at state s with the (bias-corrected) body rate
 // omega_ib_b: H (rows 0-2 position, 3-5 velocity; the first `dim` rows used), R, and the lever
 // arm's position C_b_n l_b and velocity C_b_n (omega_ib_b x l_b) - omega_ie_n x C_b_n l_b in n.
+// With the noise model's layout: the GNSS Gauss-Markov error state (if any) gets H = -I and R the
+// white part only; without such a state R holds white^2 + Gauss-Markov^2.
 struct GnssUpdateModel {
-  Eigen::Matrix<double, 6, kNumErrorStates> H = Eigen::Matrix<double, 6, kNumErrorStates>::Zero();
+  Eigen::Matrix<double, 6, Eigen::Dynamic> H;
   Eigen::Matrix<double, 6, 6> R = Eigen::Matrix<double, 6, 6>::Zero();
   Vector3d lever_n = Vector3d::Zero();
   Vector3d lever_velocity_n = Vector3d::Zero();
   int dim = 3;
 };
 GnssUpdateModel MakeGnssUpdateModel(const NavEnvironment& env, const GnssConfig& gnss,
-                                    const NavState& s, const Vector3d& omega_ib_b);
+                                    const NavState& s, const Vector3d& omega_ib_b,
+                                    const ErrorStateLayout& layout);
 
 // Linear covariance analysis of the filter (or of the free INS) along the truth trajectory of
 // `motion` at rate_hz, streamed (memory O(step_samples)): P0 at t = 0, propagated as the filter
@@ -120,7 +140,7 @@ std::vector<CovarianceEpoch> FilterCovarianceAnalysis(
     const ErrorStateMatrix& P0, const AidingSpec* aiding, const std::vector<int64_t>& zupt_epochs,
     const std::vector<int64_t>& epoch_samples, int64_t step_samples, Discretization method);
 
-// The normalised estimation error squared e^T P^-1 e (NEES) of a 15-state error.
+// The normalised estimation error squared e^T P^-1 e (NEES) of an error state.
 double Nees(const ErrorStateVector& error, const ErrorStateMatrix& P);
 
 // Two-sided 95 % bounds [chi2_0.025(n dof), chi2_0.975(n dof)] / n of the mean of n independent

@@ -124,6 +124,18 @@ struct MonteCarloSpec {
   NavigationFilterKind filter = NavigationFilterKind::kNone;
   AidingSpec aiding;
   int64_t ekf_propagation_step_samples = 10;  // InsGnssFilterOptions::propagation_step_samples
+  // What the EKF and the covariance analysis assume (issue 18; error_state.h MakeErrorStateNoise;
+  // job fields navigation.ekf.sensor, .augment_scale_misalignment, .flicker_states_per_axis):
+  //  * filter_sensor: the IMU model the filter assumes; absent = the truth model `sensor` (set it
+  //    to study a mistuned filter: the consistency check then compares the filter's belief with
+  //    the truth's Monte-Carlo spread);
+  //  * filter_augment_scale_misalignment: scale factor and misalignment as augmented states, or
+  //    (false) as a white-noise bound derived from the motion;
+  //  * filter_flicker_states_per_axis: Gauss-Markov states per axis for flicker, 1 to
+  //    kMaxFlickerComponents (default: every component of the simulator's design).
+  std::optional<ImuErrorModel> filter_sensor;
+  bool filter_augment_scale_misalignment = true;
+  int filter_flicker_states_per_axis = kMaxFlickerComponents;
   // kComplementary: kind and crossover frequencies (magnetic_declination_rad and initial_yaw_rad
   // are set per run from the magnetometer's field and the initial errors).
   ComplementaryFilterOptions complementary;

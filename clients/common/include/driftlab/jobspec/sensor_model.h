@@ -10,6 +10,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 
 #include "driftlab/sensor_params.h"
 #include "driftlab/v1/job.pb.h"
@@ -19,6 +20,10 @@ namespace driftlab::jobspec {
 // The job's sensor model, or nullopt when the job has no `sensor` (or an empty one): ideal IMU
 // data. Throws SpecError.
 std::optional<ImuErrorModel> ToImuErrorModel(const v1::Job& job);
+
+// One SensorModel message whose fields live under `prefix` (e.g. "navigation.ekf.sensor", the
+// model a mistuned filter assumes). Throws SpecError naming prefix.field.
+ImuErrorModel ToImuErrorModel(const v1::SensorModel& sensor, const std::string& prefix);
 
 }  // namespace driftlab::jobspec
 
