@@ -1,0 +1,22 @@
+// The lockstep NED lane kernel (lockstep_ned_kernel.h) for AVX2 (compiled with -mavx2, no
+// FMA), 4 lanes per group.
+// engine/CMakeLists.txt gives this file its instruction-set options; it includes no header that
+// defines inline code shared with other files (lockstep_lanes.h).
+#include "lockstep_ned_kernel.h"
+
+namespace driftlab::lockstep {
+
+#if defined(__AVX2__)
+namespace {
+void Advance4(const KernelJob& job, const KernelInputs& in, int64_t k_begin, int64_t k_end,
+              bool navigate, LockstepGroup* group) {
+  Kernel<4>::Advance(job, in, k_begin, k_end, navigate, group);
+}
+}  // namespace
+
+AdvanceFn AdvanceAvx2() { return &Advance4; }
+#else
+AdvanceFn AdvanceAvx2() { return nullptr; }
+#endif
+
+}  // namespace driftlab::lockstep
