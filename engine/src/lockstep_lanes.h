@@ -98,10 +98,21 @@ struct KernelInputs {
 using AdvanceFn = void (*)(const KernelJob& job, const KernelInputs& in, int64_t k_begin,
                            int64_t k_end, bool navigate, LockstepGroup* group);
 
-// Per-ISA entry points (defined in lockstep_ned_<isa>.cc; null where the build
-// or the architecture has no such path).
-AdvanceFn AdvanceBaseline();
-AdvanceFn AdvanceAvx2();
-AdvanceFn AdvanceAvx512();
+// N(0, 1) deviates first_index .. first_index + count - 1 of the stream (key[2], run_word,
+// stream_word): RandomStream::FillGaussian's code (random_kernels.h) built for the kernel's
+// instruction set.
+using FillFn = void (*)(const uint32_t* key, uint32_t run_word, uint32_t stream_word,
+                        uint64_t first_index, double* out, int count);
+
+struct KernelEntry {
+  AdvanceFn advance = nullptr;
+  FillFn fill = nullptr;
+};
+
+// Per-ISA entry points (defined in lockstep_ned_<isa>.cc; null where the build or the
+// architecture has no such path).
+KernelEntry EntryBaseline();
+KernelEntry EntryAvx2();
+KernelEntry EntryAvx512();
 
 }  // namespace driftlab::lockstep

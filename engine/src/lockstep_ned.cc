@@ -3,7 +3,6 @@
 #include "lockstep_ned.h"
 
 #include <cstdlib>
-#include <span>
 #include <string>
 
 #include "driftlab/spec_error.h"
@@ -164,8 +163,8 @@ void SetNavLane(const NavState& initial, int lane, LockstepGroup* group) {
   n.t0_s = initial.t_s;
 }
 
-void LoadBlock(const LockstepJob& job, int64_t block_begin, GroupStreams* streams,
-               LockstepGroup* group) {
+void LoadBlock(const LockstepJob& job, const Kernel& kernel, int64_t block_begin,
+               GroupStreams* streams, LockstepGroup* group) {
   if (!job.kernel.has_sensor) return;
   const uint64_t b0 = static_cast<uint64_t>(block_begin);
   double buffer[kBlock];
@@ -177,7 +176,8 @@ void LoadBlock(const LockstepJob& job, int64_t block_begin, GroupStreams* stream
       double(*dst)[kBlock][kMaxLanes] = PerSampleBuffer(lanes, term);
       for (int axis = 0; axis < 3; ++axis) {
         for (int lane = 0; lane < group->lanes; ++lane) {
-          streams->per_sample[t][term][axis][lane].FillGaussian(b0, std::span<double>(buffer));
+          const RandomStream& r = streams->per_sample[t][term][axis][lane];
+          kernel.fill(r.key().data(), r.run_word(), r.stream_word(), b0, buffer, kBlock);
           for (int s = 0; s < kBlock; ++s) dst[axis][s][lane] = buffer[s];
         }
       }
@@ -193,8 +193,9 @@ void LoadBlock(const LockstepJob& job, int64_t block_begin, GroupStreams* stream
       const size_t count = static_cast<size_t>((b0 + kBlock - from + period - 1) >> m);
       for (int axis = 0; axis < 3; ++axis) {
         for (int lane = 0; lane < group->lanes; ++lane) {
-          streams->Flicker(t, axis, j, lane)
-              .FillGaussian((from >> m) - 1, std::span<double>(buffer, count));
+          const RandomStream& r = streams->Flicker(t, axis, j, lane);
+          kernel.fill(r.key().data(), r.run_word(), r.stream_word(), (from >> m) - 1, buffer,
+                      static_cast<int>(count));
           for (size_t c = 0; c < count; ++c) {
             lanes.flicker_w[axis][j][((from - b0) >> m) + c][lane] = buffer[c];
           }
@@ -222,13 +223,13 @@ bool IsaAvailable(Isa isa) {
       return true;
     case Isa::kAvx2:
 #if defined(__x86_64__)
-      return AdvanceAvx2() != nullptr && __builtin_cpu_supports("avx2");
+      return EntryAvx2().advance != nullptr && __builtin_cpu_supports("avx2");
 #else
       return false;
 #endif
     case Isa::kAvx512:
 #if defined(__x86_64__)
-      return AdvanceAvx512() != nullptr && __builtin_cpu_supports("avx512f") &&
+      return EntryAvx512().advance != nullptr && __builtin_cpu_supports("avx512f") &&
              __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl");
 #else
       return false;
@@ -240,23 +241,26 @@ bool IsaAvailable(Isa isa) {
 Kernel KernelFor(Isa isa) {
   Kernel k;
   k.isa = isa;
+  KernelEntry entry;
   switch (isa) {
     case Isa::kBaseline:
       k.width = 4;
-      k.advance = AdvanceBaseline();
+      entry = EntryBaseline();
       k.name = "baseline";
       break;
     case Isa::kAvx2:
       k.width = 4;
-      k.advance = AdvanceAvx2();
+      entry = EntryAvx2();
       k.name = "avx2";
       break;
     case Isa::kAvx512:
       k.width = 8;
-      k.advance = AdvanceAvx512();
+      entry = EntryAvx512();
       k.name = "avx512";
       break;
   }
+  k.advance = entry.advance;
+  k.fill = entry.fill;
   return k;
 }
 

@@ -40,6 +40,7 @@ struct Kernel {
   Isa isa = Isa::kBaseline;
   int width = 2;  // lanes per group
   AdvanceFn advance = nullptr;
+  FillFn fill = nullptr;
   const char* name = "baseline";
 };
 
@@ -85,8 +86,8 @@ void StartSensorLane(const LockstepJob& job, uint32_t run, int lane, LockstepGro
 // resets the group's step count.
 void SetNavLane(const NavState& initial, int lane, LockstepGroup* group);
 // Loads the deviates of the block starting at sample k = block_begin (a multiple of kBlock).
-void LoadBlock(const LockstepJob& job, int64_t block_begin, GroupStreams* streams,
-               LockstepGroup* group);
+void LoadBlock(const LockstepJob& job, const Kernel& kernel, int64_t block_begin,
+               GroupStreams* streams, LockstepGroup* group);
 // Lane `lane`'s navigation state (NedMechanization::state()).
 NavState NavStateOfLane(const LockstepGroup& group, double dt_s, int lane);
 

@@ -12,11 +12,16 @@ void Advance4(const KernelJob& job, const KernelInputs& in, int64_t k_begin, int
               bool navigate, LockstepGroup* group) {
   Kernel<4>::Advance(job, in, k_begin, k_end, navigate, group);
 }
+void Fill(const uint32_t* key, uint32_t run_word, uint32_t stream_word, uint64_t first_index,
+          double* out, int count) {
+  random_kernels::FillGaussianRange(key, run_word, stream_word, first_index, out,
+                                    static_cast<size_t>(count));
+}
 }  // namespace
 
-AdvanceFn AdvanceAvx2() { return &Advance4; }
+KernelEntry EntryAvx2() { return {&Advance4, &Fill}; }
 #else
-AdvanceFn AdvanceAvx2() { return nullptr; }
+KernelEntry EntryAvx2() { return {}; }
 #endif
 
 }  // namespace driftlab::lockstep

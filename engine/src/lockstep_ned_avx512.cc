@@ -12,11 +12,16 @@ void Advance8(const KernelJob& job, const KernelInputs& in, int64_t k_begin, int
               bool navigate, LockstepGroup* group) {
   Kernel<8>::Advance(job, in, k_begin, k_end, navigate, group);
 }
+void Fill(const uint32_t* key, uint32_t run_word, uint32_t stream_word, uint64_t first_index,
+          double* out, int count) {
+  random_kernels::FillGaussianRange(key, run_word, stream_word, first_index, out,
+                                    static_cast<size_t>(count));
+}
 }  // namespace
 
-AdvanceFn AdvanceAvx512() { return &Advance8; }
+KernelEntry EntryAvx512() { return {&Advance8, &Fill}; }
 #else
-AdvanceFn AdvanceAvx512() { return nullptr; }
+KernelEntry EntryAvx512() { return {}; }
 #endif
 
 }  // namespace driftlab::lockstep

@@ -22,6 +22,7 @@
 #include <cstdint>
 
 #include "lockstep_lanes.h"
+#include "random_kernels.h"
 
 namespace driftlab::lockstep {
 namespace {

@@ -836,7 +836,7 @@ bool RunNedGroup(const SharedTruth& s, const MonteCarloSpec& spec, const lockste
   int64_t polled = 0;
   int64_t k = 1;
   while (k <= s.n) {
-    if ((k - 1) % kBlock == 0) lockstep::LoadBlock(job, k - 1, streams, group);
+    if ((k - 1) % kBlock == 0) lockstep::LoadBlock(job, kernel, k - 1, streams, group);
     // The segment [k, end): inside one deviate block, up to the next report, poll or s0.
     int64_t end = std::min<int64_t>((k - 1) / kBlock * kBlock + kBlock + 1, s.n + 1);
     end = std::min<int64_t>(end, (k + poll_every - 1) / poll_every * poll_every + 1);
