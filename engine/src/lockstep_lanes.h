@@ -9,8 +9,10 @@
 namespace driftlab::lockstep {
 
 inline constexpr int kMaxLanes = 8;
-// Samples per refill of the per-sample deviate buffers (aligned to multiples of the sample index).
-inline constexpr int kBlock = 32;
+// Samples per refill of the per-sample deviate buffers (aligned to multiples of the step index);
+// 128 rather than 32 lets the deviate loops run 32 Philox blocks per call (AVX-512 white+GM+RW:
+// 3.4 -> 4.5 M samples/s/core measured).
+inline constexpr int kBlock = 128;
 inline constexpr int kMaxFlicker = 24;  // kMaxFlickerComponents (sensors.h)
 
 // Job constants of one triad (TriadJobConstants, flattened for the kernel).
