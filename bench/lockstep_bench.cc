@@ -105,9 +105,7 @@ void BM_NedWhiteGaussMarkovRandomWalk(benchmark::State& state) {
 }
 void BM_NedTactical(benchmark::State& state) { Run(state, FindImuPreset("tactical")); }
 
-BENCHMARK(BM_NedWhiteGaussMarkovRandomWalk)
-    ->DenseRange(0, 3)
-    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_NedWhiteGaussMarkovRandomWalk)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_NedTactical)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
 
 }  // namespace

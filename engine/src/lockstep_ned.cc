@@ -112,7 +112,8 @@ void StartSensorLane(const LockstepJob& job, uint32_t run, int lane, LockstepGro
         DrawTriadRunConstants(params, job.constants[t], sensor, job.seed, run);
     TriadLanes& lanes = group->triad[t];
     for (int i = 0; i < 3; ++i) {
-      for (int c = 0; c < 3; ++c) lanes.scale_misalignment[i][c][lane] = rc.scale_misalignment(i, c);
+      for (int c = 0; c < 3; ++c)
+        lanes.scale_misalignment[i][c][lane] = rc.scale_misalignment(i, c);
       lanes.constant_bias[i][lane] = rc.constant_bias[i];
       lanes.gm_state[i][lane] = rc.gm_state[static_cast<size_t>(i)];
       lanes.rw_state[i][lane] = 0.0;

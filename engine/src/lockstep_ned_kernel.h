@@ -10,9 +10,9 @@
 //  * mechanization: NedMechanization::Update and Propagate (ins.cc) with NavEnvironment
 //    (earth.cc) and RotationVectorToQuaternion (attitude.cc); Eigen 3.4's order of operations for
 //    its small fixed-size expressions: Matrix3d * Vector3d as Dot3 below, squaredNorm of a
-//    3-vector as x0 + (x1 + x2) (its unrolled reduction halves the range), the quaternion product as its
-//    SSE2/NEON kernel (Geometry_SIMD.h), q * v as _transformVector, normalized() as division by
-//    sqrt of (x^2 + z^2) + (y^2 + w^2) (two-lane packets).
+//    3-vector as x0 + (x1 + x2) (its unrolled reduction halves the range), the quaternion product
+//    as its SSE2/NEON kernel (Geometry_SIMD.h), q * v as _transformVector, normalized() as division
+//    by sqrt of (x^2 + z^2) + (y^2 + w^2) (two-lane packets).
 // sin, cos and tan are called per lane through the C library (the scalar code's functions): the
 // first version keeps std:: there; the engine's own polynomials (DESIGN.md "Same bits
 // everywhere") would change today's bits and are left for a later step.
@@ -190,8 +190,8 @@ struct Kernel {
     const P s2 = l.s * l.s;
     const P g0 = kGammaE * (1.0 + k * s2) / Sqrt(1.0 - kE2 * s2);
     constexpr double m = kOmega * kOmega * kA * kA * kB / kGM;
-    const P g_D = g0 * (1.0 - 2.0 / kA * (1.0 + kF * (1.0 - 2.0 * s2) + m) * h +
-                        3.0 * h * h / (kA * kA));
+    const P g_D =
+        g0 * (1.0 - 2.0 / kA * (1.0 + kF * (1.0 - 2.0 * s2) + m) * h + 3.0 * h * h / (kA * kA));
     const P g_N = -8.08e-9 * h * Sin(2.0 * l.L);
     return {g_N, Splat(0.0), g_D};
   }
@@ -204,8 +204,9 @@ struct Kernel {
     return row < 2 ? (a0 + a1) + a2 : a0 + (a1 + a2);
   }
 
-  // ---- Sensor error step (TriadErrorSimulator::Apply<true>) --------------------------------------
-  // `ideal` and `additive` are the same for every lane (the shared truth); the result per lane.
+  // ---- Sensor error step (TriadErrorSimulator::Apply<true>)
+  // -------------------------------------- `ideal` and `additive` are the same for every lane (the
+  // shared truth); the result per lane.
   static V3 TriadStep(const TriadParams& p, TriadLanes& t, const double ideal[3],
                       const double additive[3], uint64_t k, int j_block, uint64_t block_begin,
                       double dt) {
@@ -266,7 +267,8 @@ struct Kernel {
     return {Load(out[0]), Load(out[1]), Load(out[2])};
   }
 
-  // ---- Mechanization (NedMechanization::Update / Propagate) ---------------------------------------
+  // ---- Mechanization (NedMechanization::Update / Propagate)
+  // ---------------------------------------
   struct Step {
     P L, lon, h;
     V3 v, zeta;
@@ -316,26 +318,24 @@ struct Kernel {
       delta_v_b = Add(delta_v_b, Scale(0.5, alpha_cross_dv));
       if (n.have_previous) {
         alpha = Add(alpha, Div(Cross(previous_dtheta, dtheta), 12.0));
-        delta_v_b = Add(delta_v_b, Div(Add(Cross(previous_dtheta, dv), Cross(previous_dv, dtheta)),
-                                       12.0));
+        delta_v_b =
+            Add(delta_v_b, Div(Add(Cross(previous_dtheta, dv), Cross(previous_dv, dtheta)), 12.0));
       }
     }
     const P L = Load(n.lat_rad), lon = Load(n.lon_rad), h = Load(n.h_m);
     const V3 v = Load3(n.v_eb_n);
     const V3 previous_v = Load3(n.previous_v_eb_n);
     const Q4 q{Load(n.q_b_n[0]), Load(n.q_b_n[1]), Load(n.q_b_n[2]), Load(n.q_b_n[3])};
-    const V3 v_mid_predicted =
-        n.have_previous ? Sub(Scale(1.5, v), Scale(0.5, previous_v)) : v;
+    const V3 v_mid_predicted = n.have_previous ? Sub(Scale(1.5, v), Scale(0.5, previous_v)) : v;
     const Lat lat = LatOf(L);
     const V3 llh_rate_old = LlhRate(job.earth, lat, h, v);
     const V3 llh_rate_mid = LlhRate(job.earth, lat, h, v_mid_predicted);
     const Step predicted =
         Propagate(job, q, L, lon, h, v, delta_v_b, alpha_cross_dv, second_order_b, llh_rate_old,
                   L + 0.5 * dt * llh_rate_mid.x, h + 0.5 * dt * llh_rate_mid.z, v_mid_predicted);
-    const Step corrected =
-        Propagate(job, q, L, lon, h, v, delta_v_b, alpha_cross_dv, second_order_b, llh_rate_old,
-                  0.5 * (L + predicted.L), 0.5 * (h + predicted.h),
-                  Scale(0.5, Add(v, predicted.v)));
+    const Step corrected = Propagate(job, q, L, lon, h, v, delta_v_b, alpha_cross_dv,
+                                     second_order_b, llh_rate_old, 0.5 * (L + predicted.L),
+                                     0.5 * (h + predicted.h), Scale(0.5, Add(v, predicted.v)));
     const V3 minus_zeta{-corrected.zeta.x, -corrected.zeta.y, -corrected.zeta.z};
     const Q4 q_new = Normalized(
         Mul(Mul(RotationVectorToQuaternion(minus_zeta), q), RotationVectorToQuaternion(alpha)));
@@ -354,8 +354,8 @@ struct Kernel {
 
   // Sample k (increment over (t_{k-1}, t_k]) is the sensor's step d = k - 1 (its deviate index,
   // TriadErrorSimulator::step()); the block holds the deviates of steps [block_begin, +kBlock).
-  static void Advance(const KernelJob& job, const KernelInputs& in, int64_t k_begin,
-                      int64_t k_end, bool navigate, LockstepGroup* group) {
+  static void Advance(const KernelJob& job, const KernelInputs& in, int64_t k_begin, int64_t k_end,
+                      bool navigate, LockstepGroup* group) {
     const uint64_t block_begin = static_cast<uint64_t>(k_begin - 1) & ~uint64_t{kBlock - 1};
     NavLanes& n = group->nav;
     for (int64_t k = k_begin; k < k_end; ++k) {
@@ -372,10 +372,9 @@ struct Kernel {
           }
         }
         const double zero[3] = {0.0, 0.0, 0.0};
-        dtheta = TriadStep(job.triad[0], group->triad[0], ideal, g_term, d, j, block_begin,
-                           job.dt_s);
-        dv = TriadStep(job.triad[1], group->triad[1], ideal + 3, zero, d, j, block_begin,
-                       job.dt_s);
+        dtheta =
+            TriadStep(job.triad[0], group->triad[0], ideal, g_term, d, j, block_begin, job.dt_s);
+        dv = TriadStep(job.triad[1], group->triad[1], ideal + 3, zero, d, j, block_begin, job.dt_s);
       } else {
         dtheta = Splat3(ideal[0], ideal[1], ideal[2]);
         dv = Splat3(ideal[3], ideal[4], ideal[5]);

@@ -12,8 +12,8 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <mutex>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -808,8 +808,8 @@ bool RunNedGroup(const SharedTruth& s, const MonteCarloSpec& spec, const lockste
     for (int lane = 0; lane < lanes; ++lane) {
       RunSink lane_sink = sink;
       lane_sink.slot = slot_begin + static_cast<uint32_t>(lane);
-      lane_sink.Record(r, ComputeNavError(s.env, lockstep::NavStateOfLane(*group, s.dt_s, lane),
-                                          r.truth));
+      lane_sink.Record(
+          r, ComputeNavError(s.env, lockstep::NavStateOfLane(*group, s.dt_s, lane), r.truth));
     }
   };
   // Navigation starts at s0 from the alignment sums of k = 1..s0 (RunNed).
@@ -865,9 +865,8 @@ void RunNedLockstep(const SharedTruth& s, const MonteCarloSpec& spec,
                     tbb::enumerable_thread_specific<EpochAccumulator>& accumulators,
                     std::vector<std::vector<ErrorComponentValues>>& checkpoint_values,
                     Monitor* monitor) {
-  const lockstep::LockstepJob job =
-      lockstep::ComposeJob(spec.sensor ? &*spec.sensor : nullptr, spec.seed, s.env, s.rate_hz,
-                           spec.simulation.ned);
+  const lockstep::LockstepJob job = lockstep::ComposeJob(
+      spec.sensor ? &*spec.sensor : nullptr, spec.seed, s.env, s.rate_hz, spec.simulation.ned);
   const uint32_t width = static_cast<uint32_t>(kernel.width);
   const uint32_t groups = (run_count + width - 1) / width;
   struct Workspace {
@@ -1210,13 +1209,14 @@ MonteCarloOutput RunMonteCarloWithAnalysis(
   tbb::task_arena arena(threads);
   // Mechanization A without a filter runs in lockstep groups (DRIFTLAB_ISA=scalar: one run at a
   // time, RunNed, kept as the reference the lockstep path must match bit for bit).
-  const bool lockstep = !seed000 && !ekf && !complementary && !lockstep::ScalarForced();
-  if (lockstep) {
+  const bool run_lockstep = !seed000 && !ekf && !complementary && !lockstep::ScalarForced();
+  if (run_lockstep) {
     RunNedLockstep(truth, spec, lockstep::SelectKernel(), gyrocompass, run_count, arena,
                    accumulators, checkpoint_values, &monitor);
   }
-  if (!lockstep) arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, run_count, 1),
+  // The other navigators, one run at a time (none left when the runs went in lockstep above).
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, run_lockstep ? 0 : run_count, 1),
                       [&](const tbb::blocked_range<uint32_t>& range) {
                         RunSink sink;
                         sink.epochs = &accumulators.local();

@@ -136,7 +136,7 @@ inline void SinCosTwoPiInline(uint32_t x, double& sin_out, double& cos_out) {
 constexpr int kChunkBlocks = 32;
 
 inline void PhiloxChunk(const uint32_t* key, uint32_t run_word, uint32_t stream_word,
-                 uint64_t block0, int nblocks, uint32_t (&x)[4][kChunkBlocks]) {
+                        uint64_t block0, int nblocks, uint32_t (&x)[4][kChunkBlocks]) {
   for (int b = 0; b < nblocks; ++b) {
     const uint64_t block = block0 + static_cast<uint64_t>(b);
     uint32_t c0 = static_cast<uint32_t>(block);
@@ -152,7 +152,7 @@ inline void PhiloxChunk(const uint32_t* key, uint32_t run_word, uint32_t stream_
 }
 
 inline void GaussianChunk(const uint32_t* key, uint32_t run_word, uint32_t stream_word,
-                   uint64_t block0, int nblocks, double* out) {
+                          uint64_t block0, int nblocks, double* out) {
   uint32_t x[4][kChunkBlocks];
   PhiloxChunk(key, run_word, stream_word, block0, nblocks, x);
   // Box-Muller on the pairs (x0, x1) -> deviates 0, 1 and (x2, x3) -> deviates 2, 3 of a block.
@@ -171,7 +171,7 @@ inline void GaussianChunk(const uint32_t* key, uint32_t run_word, uint32_t strea
 }
 
 inline void UniformChunk(const uint32_t* key, uint32_t run_word, uint32_t stream_word,
-                  uint64_t block0, int nblocks, double* out) {
+                         uint64_t block0, int nblocks, double* out) {
   uint32_t x[4][kChunkBlocks];
   PhiloxChunk(key, run_word, stream_word, block0, nblocks, x);
   for (int b = 0; b < nblocks; ++b) {
@@ -222,11 +222,9 @@ inline void FillGaussianRange(const uint32_t* key, uint32_t run_word, uint32_t s
 // U(0, 1) deviates (RandomStream::FillUniform).
 inline void FillUniformRange(const uint32_t* key, uint32_t run_word, uint32_t stream_word,
                              uint64_t first_index, double* out, size_t count) {
-  FillByChunks(
-      [&](uint64_t block0, int nblocks, double* dst) {
-        UniformChunk(key, run_word, stream_word, block0, nblocks, dst);
-      },
-      first_index, out, count);
+  FillByChunks([&](uint64_t block0, int nblocks,
+                   double* dst) { UniformChunk(key, run_word, stream_word, block0, nblocks, dst); },
+               first_index, out, count);
 }
 }  // namespace
 }  // namespace driftlab::random_kernels

@@ -231,8 +231,8 @@ TriadJobConstants ComposeTriadJobConstants(const TriadErrorParams& params, doubl
     job.gm_mean_gain = T * one_minus_a;
     job.gm_integral_w1_gain = sigma * sigma * T * one_minus_a * one_minus_a / job.gm_drive_sigma;
     const double var_eps = 2.0 * sigma * sigma * T * T * GaussMarkovIntegralShape(x);
-    job.gm_integral_w2_gain = std::sqrt(
-        std::max(0.0, var_eps - job.gm_integral_w1_gain * job.gm_integral_w1_gain));
+    job.gm_integral_w2_gain =
+        std::sqrt(std::max(0.0, var_eps - job.gm_integral_w1_gain * job.gm_integral_w1_gain));
   }
 
   if (params.random_walk > 0.0) {
@@ -322,10 +322,9 @@ TriadErrorSimulator::TriadErrorSimulator(const TriadErrorParams& params, SensorI
     for (int axis = 0; axis < 3; ++axis) {
       for (int component = 0; component < count_per_axis; ++component) {
         channels_.emplace_back();
-        channels_.back().stream =
-            RandomStream(seed, run_index,
-                         StreamKey{sensor, static_cast<uint8_t>(axis), term,
-                                   static_cast<uint8_t>(component)});
+        channels_.back().stream = RandomStream(
+            seed, run_index,
+            StreamKey{sensor, static_cast<uint8_t>(axis), term, static_cast<uint8_t>(component)});
       }
     }
     return first;
