@@ -18,6 +18,8 @@
 // everywhere") would change today's bits and are left for a later step.
 #pragma once
 
+#include <math.h>
+
 #include <cmath>
 #include <cstdint>
 
@@ -64,6 +66,17 @@ struct Kernel {
   static P Sqrt(P x) {
     for (int i = 0; i < W; ++i) x[i] = __builtin_sqrt(x[i]);
     return x;
+  }
+  // sin and cos of one argument in one sincos call where the C library has it (glibc computes
+  // both with the code of sin and cos, so the bits are theirs; lockstep_ned_test checks every
+  // path against the scalar code).
+  static void SinCos(double x, double* sin_x, double* cos_x) {
+#if defined(__GLIBC__)
+    ::sincos(x, sin_x, cos_x);
+#else
+    *sin_x = std::sin(x);
+    *cos_x = std::cos(x);
+#endif
   }
   static P Sin(P x) {
     for (int i = 0; i < W; ++i) x[i] = std::sin(x[i]);
@@ -136,8 +149,10 @@ struct Kernel {
         w = 1.0 - a2 / 8.0 + a2 * a2 / 384.0;
         k = 0.5 - a2 / 48.0 + a2 * a2 / 3840.0;
       } else {
-        w = std::cos(0.5 * a);
-        k = std::sin(0.5 * a) / a;
+        double sin_half, cos_half;
+        SinCos(0.5 * a, &sin_half, &cos_half);
+        w = cos_half;
+        k = sin_half / a;
       }
       q.w[i] = w;
       q.x[i] = k * rx;
@@ -162,7 +177,16 @@ struct Kernel {
   struct Lat {
     P L, s, c;
   };
-  static Lat LatOf(P L) { return {L, Sin(L), Cos(L)}; }
+  static Lat LatOf(P L) {
+    Lat l{L, L, L};
+    for (int i = 0; i < W; ++i) {
+      double sin_L, cos_L;
+      SinCos(L[i], &sin_L, &cos_L);
+      l.s[i] = sin_L;
+      l.c[i] = cos_L;
+    }
+    return l;
+  }
   static P MeridianRadius(const Lat& l) {
     const P d = 1.0 - kE2 * l.s * l.s;
     return kA * (1.0 - kE2) / (d * Sqrt(d));
