@@ -18,6 +18,9 @@
 // code does; -ffp-contract=off everywhere. Deviates come from the same RandomStream keys and
 // indices. So a run's result is the same whichever lane, group, thread, shard or instruction set
 // computes it, and equal to the scalar RunNed's (lockstep_ned_test.cc checks all of this).
+// (The equality between lockstep paths holds for any build; the equality with RunNed assumes
+// Eigen's operation order of the default x86-64 / arm64 build, which a build of the scalar code
+// with wider Eigen packets, e.g. -march=native with AVX, could change.)
 #pragma once
 
 #include <cstdint>
