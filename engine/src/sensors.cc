@@ -193,59 +193,22 @@ void TriadErrorSimulator::Channel::Refill(uint64_t index) {
   stream.FillGaussian(base, std::span<double>(buffer));
 }
 
-TriadErrorSimulator::TriadErrorSimulator(const TriadErrorParams& params, SensorId sensor,
-                                         uint64_t seed, uint32_t run_index, double rate_hz,
-                                         const std::string& path) {
+TriadJobConstants ComposeTriadJobConstants(const TriadErrorParams& params, double rate_hz,
+                                           const std::string& path) {
   ValidateTriadErrorParams(params, path);
   if (!std::isfinite(rate_hz) || rate_hz <= 0.0) {
     throw SpecError("rate_hz", FormatValue(rate_hz), "finite value > 0 [Hz]");
   }
-  dt_s_ = 1.0 / rate_hz;
-  const double dt = dt_s_;
-  auto stream = [&](ErrorTerm term, int axis, int component) {
-    return RandomStream(
-        seed, run_index,
-        StreamKey{sensor, static_cast<uint8_t>(axis), term, static_cast<uint8_t>(component)});
-  };
-  auto add_channels = [&](ErrorTerm term, int count_per_axis) {
-    const int first = static_cast<int>(channels_.size());
-    for (int axis = 0; axis < 3; ++axis) {
-      for (int component = 0; component < count_per_axis; ++component) {
-        channels_.emplace_back();
-        channels_.back().stream = stream(term, axis, component);
-      }
-    }
-    return first;
-  };
-
-  // Per-run constants: I + S + M and the constant bias.
-  for (int i = 0; i < 3; ++i) {
-    double s = params.scale_factor_fixed[i];
-    if (params.scale_factor_sigma > 0.0) {
-      s += params.scale_factor_sigma * stream(ErrorTerm::kScaleFactor, i, 0).Gaussian(0);
-    }
-    scale_misalignment_(i, i) = 1.0 + s;
-    for (int c = 0; c < 3; ++c) {
-      if (c == i) continue;
-      double m = params.misalignment_fixed(i, c);
-      if (params.misalignment_sigma_rad > 0.0) {
-        m += params.misalignment_sigma_rad * stream(ErrorTerm::kMisalignment, i, c).Gaussian(0);
-      }
-      scale_misalignment_(i, c) = m;
-    }
-    double b = params.fixed_bias[i];
-    if (params.turn_on_bias_sigma > 0.0) {
-      b += params.turn_on_bias_sigma * stream(ErrorTerm::kTurnOnBias, i, 0).Gaussian(0);
-    }
-    constant_bias_[i] = b;
-  }
-  half_asymmetry_ = 0.5 * params.scale_factor_asymmetry;
-  has_asymmetry_ = !params.scale_factor_asymmetry.isZero(0.0);
+  TriadJobConstants job;
+  job.dt_s = 1.0 / rate_hz;
+  const double dt = job.dt_s;
+  job.half_asymmetry = 0.5 * params.scale_factor_asymmetry;
+  job.has_asymmetry = !params.scale_factor_asymmetry.isZero(0.0);
 
   if (params.white_noise_density > 0.0) {
-    white_increment_ = params.white_noise_density * std::sqrt(dt);
-    white_sample_ = params.white_noise_density / std::sqrt(dt);
-    white_ch_ = add_channels(ErrorTerm::kWhiteNoise, 1);
+    job.white_noise = true;
+    job.white_increment = params.white_noise_density * std::sqrt(dt);
+    job.white_sample = params.white_noise_density / std::sqrt(dt);
   }
 
   if (params.bias_gauss_markov.sigma > 0.0) {
@@ -262,59 +225,146 @@ TriadErrorSimulator::TriadErrorSimulator(const TriadErrorParams& params, SensorI
     const double x = dt / T;
     const double one_minus_a = -std::expm1(-x);
     const double one_minus_a2 = -std::expm1(-2.0 * x);
-    gm_a_ = std::exp(-x);
-    gm_drive_ = sigma * std::sqrt(one_minus_a2);
-    gm_mean_gain_ = T * one_minus_a;
-    gm_c_ = sigma * sigma * T * one_minus_a * one_minus_a / gm_drive_;
+    job.gauss_markov = true;
+    job.gm_decay = std::exp(-x);
+    job.gm_drive_sigma = sigma * std::sqrt(one_minus_a2);
+    job.gm_mean_gain = T * one_minus_a;
+    job.gm_integral_w1_gain = sigma * sigma * T * one_minus_a * one_minus_a / job.gm_drive_sigma;
     const double var_eps = 2.0 * sigma * sigma * T * T * GaussMarkovIntegralShape(x);
-    gm_d_ = std::sqrt(std::max(0.0, var_eps - gm_c_ * gm_c_));
-    gm_ch_ = add_channels(ErrorTerm::kGaussMarkov, 1);
-    gm_int_ch_ = add_channels(ErrorTerm::kGaussMarkovIntegral, 1);
-    // Stationary start N(0, sigma^2), or 0 (GaussMarkovParams::start_at_zero). The start draw has
-    // its own stream, so skipping it changes no other deviate of the run.
-    for (int i = 0; i < 3; ++i) {
-      gm_state_[i] = params.bias_gauss_markov.start_at_zero
-                         ? 0.0
-                         : sigma * stream(ErrorTerm::kInitialState, i, 0).Gaussian(0);
-    }
+    job.gm_integral_w2_gain =
+        std::sqrt(std::max(0.0, var_eps - job.gm_integral_w1_gain * job.gm_integral_w1_gain));
   }
 
   if (params.random_walk > 0.0) {
     // b_{k+1} = b_k + K W(h); I_k = b_k h + K int_0^h (h - u) dW(u). Given the step, the integral
     // is b_k h + (h/2) (b_{k+1} - b_k) + a Brownian-bridge term of variance K^2 h^3 / 12
     // (Var int (h-u) dW = h^3/3, Cov with W(h) = h^2/2: h^3/3 - (h^2/2)^2 / h = h^3/12).
-    rw_step_ = params.random_walk * std::sqrt(dt);
-    rw_bridge_ = params.random_walk * dt * std::sqrt(dt / 12.0);
+    job.random_walk = true;
+    job.rw_step_sigma = params.random_walk * std::sqrt(dt);
+    job.rw_bridge_sigma = params.random_walk * dt * std::sqrt(dt / 12.0);
+  }
+
+  job.flicker = DesignFlickerApproximation(params.bias_flicker);
+  // Component j is advanced exactly every h_j = 2^m dt, the largest such h_j <= tau_j / 32
+  // (m = 0 when tau_j < 32 dt), and held between updates. Holding changes the component's
+  // Allan variance by < 0.1 % at t >= tau_j and less at longer t (zero-order hold of the exact
+  // AR(1) sequence; checked numerically at h = tau / 32), while slow components then cost a
+  // deviate only every 2^m samples.
+  for (size_t j = 0; j < job.flicker.size(); ++j) {
+    const double T = job.flicker[j].tau_s;
+    int m = 0;
+    while (m < 40 && std::ldexp(dt, m + 1) <= T / 32.0) ++m;
+    const double h = std::ldexp(dt, m);
+    job.flicker_period_log2[j] = m;
+    job.flicker_decay[j] = std::exp(-h / T);
+    job.flicker_drive_sigma[j] = job.flicker[j].sigma * std::sqrt(-std::expm1(-2.0 * h / T));
+  }
+  job.range = params.range;
+  job.quantization = params.quantization;
+  return job;
+}
+
+TriadRunConstants DrawTriadRunConstants(const TriadErrorParams& params,
+                                        const TriadJobConstants& job, SensorId sensor,
+                                        uint64_t seed, uint32_t run_index) {
+  auto stream = [&](ErrorTerm term, int axis, int component) {
+    return RandomStream(
+        seed, run_index,
+        StreamKey{sensor, static_cast<uint8_t>(axis), term, static_cast<uint8_t>(component)});
+  };
+  TriadRunConstants run;
+  for (int i = 0; i < 3; ++i) {
+    double s = params.scale_factor_fixed[i];
+    if (params.scale_factor_sigma > 0.0) {
+      s += params.scale_factor_sigma * stream(ErrorTerm::kScaleFactor, i, 0).Gaussian(0);
+    }
+    run.scale_misalignment(i, i) = 1.0 + s;
+    for (int c = 0; c < 3; ++c) {
+      if (c == i) continue;
+      double m = params.misalignment_fixed(i, c);
+      if (params.misalignment_sigma_rad > 0.0) {
+        m += params.misalignment_sigma_rad * stream(ErrorTerm::kMisalignment, i, c).Gaussian(0);
+      }
+      run.scale_misalignment(i, c) = m;
+    }
+    double b = params.fixed_bias[i];
+    if (params.turn_on_bias_sigma > 0.0) {
+      b += params.turn_on_bias_sigma * stream(ErrorTerm::kTurnOnBias, i, 0).Gaussian(0);
+    }
+    run.constant_bias[i] = b;
+  }
+  // Stationary start N(0, sigma^2), or 0 (GaussMarkovParams::start_at_zero). The start draw has
+  // its own stream, so skipping it changes no other deviate of the run.
+  if (job.gauss_markov && !params.bias_gauss_markov.start_at_zero) {
+    for (int i = 0; i < 3; ++i) {
+      run.gm_state[i] =
+          params.bias_gauss_markov.sigma * stream(ErrorTerm::kInitialState, i, 0).Gaussian(0);
+    }
+  }
+  for (size_t j = 0; j < job.flicker.size(); ++j) {
+    for (int i = 0; i < 3; ++i) {
+      run.flicker_state[i][j] =
+          job.flicker[j].sigma *
+          stream(ErrorTerm::kInitialState, i, 1 + static_cast<int>(j)).Gaussian(0);
+    }
+  }
+  return run;
+}
+
+TriadErrorSimulator::TriadErrorSimulator(const TriadErrorParams& params, SensorId sensor,
+                                         uint64_t seed, uint32_t run_index, double rate_hz,
+                                         const std::string& path) {
+  const TriadJobConstants job = ComposeTriadJobConstants(params, rate_hz, path);
+  const TriadRunConstants run = DrawTriadRunConstants(params, job, sensor, seed, run_index);
+  dt_s_ = job.dt_s;
+  auto add_channels = [&](ErrorTerm term, int count_per_axis) {
+    const int first = static_cast<int>(channels_.size());
+    for (int axis = 0; axis < 3; ++axis) {
+      for (int component = 0; component < count_per_axis; ++component) {
+        channels_.emplace_back();
+        channels_.back().stream = RandomStream(
+            seed, run_index,
+            StreamKey{sensor, static_cast<uint8_t>(axis), term, static_cast<uint8_t>(component)});
+      }
+    }
+    return first;
+  };
+  scale_misalignment_ = run.scale_misalignment;
+  constant_bias_ = run.constant_bias;
+  half_asymmetry_ = job.half_asymmetry;
+  has_asymmetry_ = job.has_asymmetry;
+  if (job.white_noise) {
+    white_increment_ = job.white_increment;
+    white_sample_ = job.white_sample;
+    white_ch_ = add_channels(ErrorTerm::kWhiteNoise, 1);
+  }
+  if (job.gauss_markov) {
+    gm_a_ = job.gm_decay;
+    gm_drive_ = job.gm_drive_sigma;
+    gm_mean_gain_ = job.gm_mean_gain;
+    gm_c_ = job.gm_integral_w1_gain;
+    gm_d_ = job.gm_integral_w2_gain;
+    gm_ch_ = add_channels(ErrorTerm::kGaussMarkov, 1);
+    gm_int_ch_ = add_channels(ErrorTerm::kGaussMarkovIntegral, 1);
+    gm_state_ = run.gm_state;
+  }
+  if (job.random_walk) {
+    rw_step_ = job.rw_step_sigma;
+    rw_bridge_ = job.rw_bridge_sigma;
     rw_ch_ = add_channels(ErrorTerm::kRandomWalk, 1);
     rw_int_ch_ = add_channels(ErrorTerm::kRandomWalkIntegral, 1);
   }
-
-  flicker_ = DesignFlickerApproximation(params.bias_flicker);
+  flicker_ = job.flicker;
   n_flicker_ = static_cast<int>(flicker_.size());
   if (n_flicker_ > 0) {
-    // Component j is advanced exactly every h_j = 2^m dt, the largest such h_j <= tau_j / 32
-    // (m = 0 when tau_j < 32 dt), and held between updates. Holding changes the component's
-    // Allan variance by < 0.1 % at t >= tau_j and less at longer t (zero-order hold of the exact
-    // AR(1) sequence; checked numerically at h = tau / 32), while slow components then cost a
-    // deviate only every 2^m samples.
-    for (int j = 0; j < n_flicker_; ++j) {
-      const double T = flicker_[j].tau_s;
-      int m = 0;
-      while (m < 40 && std::ldexp(dt, m + 1) <= T / 32.0) ++m;
-      const double h = std::ldexp(dt, m);
-      flicker_period_log2_[j] = m;
-      flicker_a_[j] = std::exp(-h / T);
-      flicker_drive_[j] = flicker_[j].sigma * std::sqrt(-std::expm1(-2.0 * h / T));
-      for (int i = 0; i < 3; ++i) {
-        flicker_state_[i][j] =
-            flicker_[j].sigma * stream(ErrorTerm::kInitialState, i, 1 + j).Gaussian(0);
-      }
-    }
+    flicker_a_ = job.flicker_decay;
+    flicker_drive_ = job.flicker_drive_sigma;
+    flicker_period_log2_ = job.flicker_period_log2;
+    flicker_state_ = run.flicker_state;
     flicker_ch_ = add_channels(ErrorTerm::kFlicker, n_flicker_);
   }
-
-  range_ = params.range;
-  quantization_ = params.quantization;
+  range_ = job.range;
+  quantization_ = job.quantization;
 }
 
 template <bool kIncrement>

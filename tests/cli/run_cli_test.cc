@@ -125,6 +125,38 @@ TEST(Run, FourShardsMergedEqualOneProcessAndThreadsDoNotMatter) {
   EXPECT_FALSE(fs::exists(file("bad.json")));
 }
 
+// Issue 17: the result file is the same to the byte on every instruction-set path of the
+// lockstep runner (DRIFTLAB_ISA, inherited by the child process) and on the scalar reference.
+TEST(Run, EveryInstructionSetPathWritesTheSameResultFile) {
+  Scratch scratch;
+  const std::string job = (kData / "mc_small.json").string();
+  auto file = [&scratch](const std::string& name) { return (scratch.dir() / name).string(); };
+  std::vector<std::string> paths = {"scalar", "baseline"};
+#if defined(__x86_64__)
+  if (__builtin_cpu_supports("avx2")) paths.push_back("avx2");
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+      __builtin_cpu_supports("avx512vl")) {
+    paths.push_back("avx512");
+  }
+#endif
+  std::string reference;
+  for (const std::string& path : paths) {
+    SCOPED_TRACE(path);
+    setenv("DRIFTLAB_ISA", path.c_str(), 1);
+    const Result r = RunDriftlab({"run", job, "--out", file(path + ".json"), "-q"}, scratch);
+    unsetenv("DRIFTLAB_ISA");
+    ASSERT_EQ(r.exit_status, 0) << r.err;
+    const std::string text = WithoutTimings(ReadFile(file(path + ".json")));
+    if (reference.empty()) reference = text;
+    EXPECT_TRUE(text == reference);  // the files are too long to print
+  }
+  setenv("DRIFTLAB_ISA", "sse9", 1);
+  const Result bad = RunDriftlab({"run", job, "--out", file("bad.json"), "-q"}, scratch);
+  unsetenv("DRIFTLAB_ISA");
+  EXPECT_EQ(bad.exit_status, 2);
+  EXPECT_NE(bad.err.find("DRIFTLAB_ISA"), std::string::npos) << bad.err;
+}
+
 TEST(Run, BadCommandLinesAndJobsNameTheField) {
   Scratch scratch;
   const std::string job = (kData / "mc_small.json").string();

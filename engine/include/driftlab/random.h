@@ -96,6 +96,12 @@ class RandomStream {
   double Gaussian(uint64_t index) const;
   double Uniform(uint64_t index) const;
 
+  // The Philox key and the counter's run and stream words (layout above), for kernels that
+  // produce a stream's deviates themselves (engine/src/random_kernels.h, the same code).
+  const std::array<uint32_t, 2>& key() const { return key_; }
+  uint32_t run_word() const { return run_word_; }
+  uint32_t stream_word() const { return stream_word_; }
+
  private:
   std::array<uint32_t, 2> key_{};
   uint32_t run_word_ = 0;

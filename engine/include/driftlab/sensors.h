@@ -97,6 +97,52 @@ std::vector<GaussMarkovComponent> DesignFlickerApproximation(const FlickerParams
 double SumOfGaussMarkovAllanDeviation(const std::vector<GaussMarkovComponent>& components,
                                       double tau_avg_s);
 
+// The job constants of one triad at one output rate: every coefficient of the per-sample step
+// that depends on the model and the rate only (sensors.cc derives each). Composed once per job
+// (ComposeTriadJobConstants) and shared read-only by all runs, by TriadErrorSimulator and by the
+// lockstep runner (lockstep_ned.h).
+struct TriadJobConstants {
+  double dt_s = 0.0;
+  Eigen::Vector3d half_asymmetry = Eigen::Vector3d::Zero();
+  bool has_asymmetry = false;
+  // White noise: deviate scale for increments (N sqrt(dt)) and point samples (N / sqrt(dt)).
+  bool white_noise = false;
+  double white_increment = 0.0, white_sample = 0.0;
+  // Gauss-Markov: b' = gm_decay b + gm_drive_sigma w1; increment integral =
+  // gm_mean_gain b + gm_integral_w1_gain w1 + gm_integral_w2_gain w2 (sensors.cc).
+  bool gauss_markov = false;
+  double gm_decay = 0.0, gm_drive_sigma = 0.0, gm_mean_gain = 0.0;
+  double gm_integral_w1_gain = 0.0, gm_integral_w2_gain = 0.0;
+  // Random walk: b' = b + rw_step_sigma w1; increment integral = b dt + (dt/2) step +
+  // rw_bridge_sigma w2.
+  bool random_walk = false;
+  double rw_step_sigma = 0.0, rw_bridge_sigma = 0.0;
+  // Flicker: the design and, per component j, the decay and drive over its update period
+  // 2^flicker_period_log2[j] samples.
+  std::vector<GaussMarkovComponent> flicker;
+  std::array<double, kMaxFlickerComponents> flicker_decay{};
+  std::array<double, kMaxFlickerComponents> flicker_drive_sigma{};
+  std::array<int, kMaxFlickerComponents> flicker_period_log2{};
+  double range = 0.0;         // 0 = off
+  double quantization = 0.0;  // increment LSB; 0 = off
+};
+
+// Validates `params` (field path `path`) and rate_hz, then composes the job constants.
+TriadJobConstants ComposeTriadJobConstants(const TriadErrorParams& params, double rate_hz,
+                                           const std::string& path = "sensor");
+
+// The constants of one triad in one run, drawn from the run's streams: I + S + M (without
+// asymmetry), b_fixed + b_turn_on, and the start states of the Gauss-Markov and flicker terms.
+struct TriadRunConstants {
+  Eigen::Matrix3d scale_misalignment = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d constant_bias = Eigen::Vector3d::Zero();
+  std::array<double, 3> gm_state{};
+  std::array<std::array<double, kMaxFlickerComponents>, 3> flicker_state{};
+};
+TriadRunConstants DrawTriadRunConstants(const TriadErrorParams& params,
+                                        const TriadJobConstants& job, SensorId sensor,
+                                        uint64_t seed, uint32_t run_index);
+
 // Error simulator of one sensor triad for one run. Built once per run (allocates then); Apply*
 // is the per-sample hot path. Not thread-safe (it holds the run's state); use one per run.
 class TriadErrorSimulator {

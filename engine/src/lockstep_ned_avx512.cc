@@ -1,0 +1,27 @@
+// The lockstep NED lane kernel (lockstep_ned_kernel.h) for AVX-512 (compiled with -mavx512f
+// -mavx512dq -mavx512vl, no FMA), 8 lanes per group.
+// engine/CMakeLists.txt gives this file its instruction-set options; it includes no header that
+// defines inline code shared with other files (lockstep_lanes.h).
+#include "lockstep_ned_kernel.h"
+
+namespace driftlab::lockstep {
+
+#if defined(__AVX512F__)
+namespace {
+void Advance8(const KernelJob& job, const KernelInputs& in, int64_t k_begin, int64_t k_end,
+              bool navigate, LockstepGroup* group) {
+  Kernel<8>::Advance(job, in, k_begin, k_end, navigate, group);
+}
+void Fill(const uint32_t* key, uint32_t run_word, uint32_t stream_word, uint64_t first_index,
+          double* out, int count) {
+  random_kernels::FillGaussianRange(key, run_word, stream_word, first_index, out,
+                                    static_cast<size_t>(count));
+}
+}  // namespace
+
+KernelEntry EntryAvx512() { return {&Advance8, &Fill}; }
+#else
+KernelEntry EntryAvx512() { return {}; }
+#endif
+
+}  // namespace driftlab::lockstep

@@ -1,0 +1,23 @@
+// The lockstep NED lane kernel (lockstep_ned_kernel.h) for the baseline instruction set (x86-64
+// SSE2, or any other architecture), 4 lanes per group.
+// engine/CMakeLists.txt gives this file its instruction-set options; it includes no header that
+// defines inline code shared with other files (lockstep_lanes.h).
+#include "lockstep_ned_kernel.h"
+
+namespace driftlab::lockstep {
+
+namespace {
+void Advance4(const KernelJob& job, const KernelInputs& in, int64_t k_begin, int64_t k_end,
+              bool navigate, LockstepGroup* group) {
+  Kernel<4>::Advance(job, in, k_begin, k_end, navigate, group);
+}
+void Fill(const uint32_t* key, uint32_t run_word, uint32_t stream_word, uint64_t first_index,
+          double* out, int count) {
+  random_kernels::FillGaussianRange(key, run_word, stream_word, first_index, out,
+                                    static_cast<size_t>(count));
+}
+}  // namespace
+
+KernelEntry EntryBaseline() { return {&Advance4, &Fill}; }
+
+}  // namespace driftlab::lockstep

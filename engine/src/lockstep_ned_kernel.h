@@ -1,0 +1,423 @@
+// The lane kernel of the lockstep NED runner (lockstep_ned.h), written once over the lane width
+// W and compiled once per instruction set (lockstep_ned_{baseline,avx2,avx512}.cc include this
+// file). Everything here has internal linkage and uses no Eigen or standard-library templates:
+// each kernel file keeps its own copy, compiled for its instruction set only.
+//
+// The arithmetic is lane-wise IEEE (GCC vector extensions: +, -, *, / and sqrt are correctly
+// rounded per lane whatever the vector width) with -ffp-contract=off, and each expression is the
+// scalar code's, operation for operation and in the same order:
+//  * sensor error step: TriadErrorSimulator::Apply<true> (sensors.cc);
+//  * mechanization: NedMechanization::Update and Propagate (ins.cc) with NavEnvironment
+//    (earth.cc) and RotationVectorToQuaternion (attitude.cc); Eigen 3.4's order of operations for
+//    its small fixed-size expressions: Matrix3d * Vector3d as Dot3 below, squaredNorm of a
+//    3-vector as x0 + (x1 + x2) (its unrolled reduction halves the range), the quaternion product
+//    as its SSE2/NEON kernel (Geometry_SIMD.h), q * v as _transformVector, normalized() as division
+//    by sqrt of (x^2 + z^2) + (y^2 + w^2) (two-lane packets).
+// sin, cos and tan are called per lane through the C library (the scalar code's functions): the
+// first version keeps std:: there; the engine's own polynomials (DESIGN.md "Same bits
+// everywhere") would change today's bits and are left for a later step.
+#pragma once
+
+#include <math.h>
+
+#include <cmath>
+#include <cstdint>
+
+#include "lockstep_lanes.h"
+#include "random_kernels.h"
+
+namespace driftlab::lockstep {
+namespace {
+
+template <int W>
+struct LaneTypes {
+  typedef double P __attribute__((vector_size(W * sizeof(double))));
+};
+
+template <int W>
+struct Kernel {
+  using P = typename LaneTypes<W>::P;
+
+  struct V3 {
+    P x, y, z;
+  };
+  struct Q4 {
+    P w, x, y, z;
+  };
+
+  static P Load(const double* p) {
+    P v;
+    __builtin_memcpy(&v, p, sizeof(v));
+    return v;
+  }
+  static void Store(double* p, P v) { __builtin_memcpy(p, &v, sizeof(v)); }
+  static P Splat(double x) {
+    P v = {};
+    return v + x;
+  }
+  static V3 Load3(const double (*a)[kMaxLanes]) { return {Load(a[0]), Load(a[1]), Load(a[2])}; }
+  static void Store3(double (*a)[kMaxLanes], const V3& v) {
+    Store(a[0], v.x);
+    Store(a[1], v.y);
+    Store(a[2], v.z);
+  }
+  static V3 Splat3(double x, double y, double z) { return {Splat(x), Splat(y), Splat(z)}; }
+
+  static P Sqrt(P x) {
+    for (int i = 0; i < W; ++i) x[i] = __builtin_sqrt(x[i]);
+    return x;
+  }
+  // sin and cos of one argument in one sincos call where the C library has it (glibc computes
+  // both with the code of sin and cos, so the bits are theirs; lockstep_ned_test checks every
+  // path against the scalar code).
+  static void SinCos(double x, double* sin_x, double* cos_x) {
+#if defined(__GLIBC__)
+    ::sincos(x, sin_x, cos_x);
+#else
+    *sin_x = std::sin(x);
+    *cos_x = std::cos(x);
+#endif
+  }
+  static P Sin(P x) {
+    for (int i = 0; i < W; ++i) x[i] = std::sin(x[i]);
+    return x;
+  }
+  static P Cos(P x) {
+    for (int i = 0; i < W; ++i) x[i] = std::cos(x[i]);
+    return x;
+  }
+  static P Tan(P x) {
+    for (int i = 0; i < W; ++i) x[i] = std::tan(x[i]);
+    return x;
+  }
+
+  static V3 Add(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+  static V3 Sub(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+  static V3 Scale(double s, const V3& a) { return {s * a.x, s * a.y, s * a.z}; }
+  static V3 Scale(const V3& a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+  static V3 ScaleP(const P& s, const V3& a) { return {s * a.x, s * a.y, s * a.z}; }
+  static V3 Div(const V3& a, double s) { return {a.x / s, a.y / s, a.z / s}; }
+  // Eigen's cross product of 3-vectors (OrthoMethods.h).
+  static V3 Cross(const V3& a, const V3& b) {
+    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+  }
+  // Eigen's q * v (_transformVector): uv = 2 (q.vec x v); v + w uv + q.vec x uv.
+  static V3 Rotate(const Q4& q, const V3& v) {
+    const V3 qv{q.x, q.y, q.z};
+    V3 uv = Cross(qv, v);
+    uv = Add(uv, uv);
+    return Add(Add(v, ScaleP(q.w, uv)), Cross(qv, uv));
+  }
+  // Eigen's Quaternion<double> product, SSE2/NEON kernel (Geometry_SIMD.h), a * b.
+  static Q4 Mul(const Q4& a, const Q4& b) {
+    Q4 r;
+    r.x = (a.w * b.x + a.y * b.z) - (a.z * b.y - a.x * b.w);
+    r.y = (a.w * b.y + a.y * b.w) + (a.z * b.x - a.x * b.z);
+    r.z = (a.w * b.z - a.y * b.x) + (a.z * b.w + a.x * b.y);
+    r.w = (a.w * b.w - a.y * b.y) - (a.z * b.z + a.x * b.x);
+    return r;
+  }
+  // Eigen's normalized() of a Quaternion<double> (coeffs x, y, z, w in two-lane packets).
+  static Q4 Normalized(const Q4& q) {
+    const P n2 = (q.x * q.x + q.z * q.z) + (q.y * q.y + q.w * q.w);
+    const P n = Sqrt(n2);
+    Q4 r;
+    for (int i = 0; i < W; ++i) {
+      if (n2[i] > 0.0) {
+        r.w[i] = q.w[i] / n[i];
+        r.x[i] = q.x[i] / n[i];
+        r.y[i] = q.y[i] / n[i];
+        r.z[i] = q.z[i] / n[i];
+      } else {
+        r.w[i] = q.w[i];
+        r.x[i] = q.x[i];
+        r.y[i] = q.y[i];
+        r.z[i] = q.z[i];
+      }
+    }
+    return r;
+  }
+  // RotationVectorToQuaternion (attitude.cc), per lane (it branches on the angle).
+  static Q4 RotationVectorToQuaternion(const V3& rho) {
+    Q4 q;
+    for (int i = 0; i < W; ++i) {
+      const double rx = rho.x[i], ry = rho.y[i], rz = rho.z[i];
+      const double a2 = rx * rx + (ry * ry + rz * rz);
+      const double a = __builtin_sqrt(a2);
+      double w, k;
+      if (a < 1e-4) {
+        w = 1.0 - a2 / 8.0 + a2 * a2 / 384.0;
+        k = 0.5 - a2 / 48.0 + a2 * a2 / 3840.0;
+      } else {
+        double sin_half, cos_half;
+        SinCos(0.5 * a, &sin_half, &cos_half);
+        w = cos_half;
+        k = sin_half / a;
+      }
+      q.w[i] = w;
+      q.x[i] = k * rx;
+      q.y[i] = k * ry;
+      q.z[i] = k * rz;
+    }
+    return q;
+  }
+
+  // ---- Earth (earth.cc) ------------------------------------------------------------------------
+  static constexpr double kA = 6378137.0;
+  static constexpr double kF = 1.0 / 298.257223563;
+  static constexpr double kE2 = kF * (2.0 - kF);
+  static constexpr double kB = kA * (1.0 - kF);
+  static constexpr double kOmega = 7.292115e-5;
+  static constexpr double kGM = 3.986004418e14;
+  static constexpr double kGammaE = 9.7803253359;
+  static constexpr double kGammaP = 9.8321849378;
+
+  // sin L computed once per latitude and reused: the scalar code calls sin(L) several times on
+  // the same argument, each giving the same bits.
+  struct Lat {
+    P L, s, c;
+  };
+  static Lat LatOf(P L) {
+    Lat l{L, L, L};
+    for (int i = 0; i < W; ++i) {
+      double sin_L, cos_L;
+      SinCos(L[i], &sin_L, &cos_L);
+      l.s[i] = sin_L;
+      l.c[i] = cos_L;
+    }
+    return l;
+  }
+  static P MeridianRadius(const Lat& l) {
+    const P d = 1.0 - kE2 * l.s * l.s;
+    return kA * (1.0 - kE2) / (d * Sqrt(d));
+  }
+  static P TransverseRadius(const Lat& l) { return kA / Sqrt(1.0 - kE2 * l.s * l.s); }
+
+  static V3 LlhRate(const EarthParams& e, const Lat& l, P h, const V3& v) {
+    if (e.flat) return {v.x / e.flat_R_N_m, v.y / e.flat_R_E_m, -v.z};
+    return {v.x / (MeridianRadius(l) + h), v.y / ((TransverseRadius(l) + h) * l.c), -v.z};
+  }
+  static V3 EarthRate(const EarthParams& e, const Lat& l) {
+    if (e.flat) return Splat3(0.0, 0.0, 0.0);
+    return {kOmega * l.c, Splat(0.0), -kOmega * l.s};
+  }
+  static V3 TransportRate(const EarthParams& e, const Lat& l, P h, const V3& v) {
+    if (e.flat) return Splat3(0.0, 0.0, 0.0);
+    const P R_E = TransverseRadius(l) + h;
+    const P R_N = MeridianRadius(l) + h;
+    return {v.y / R_E, -v.x / R_N, -v.y * Tan(l.L) / R_E};
+  }
+  static V3 Gravity(const EarthParams& e, const Lat& l, P h) {
+    if (e.flat) return Splat3(0.0, 0.0, e.flat_gravity_m_per_s2);
+    // SomiglianaGravity and GravityNed, earth.cc.
+    constexpr double k = kB * kGammaP / (kA * kGammaE) - 1.0;
+    const P s2 = l.s * l.s;
+    const P g0 = kGammaE * (1.0 + k * s2) / Sqrt(1.0 - kE2 * s2);
+    constexpr double m = kOmega * kOmega * kA * kA * kB / kGM;
+    const P g_D =
+        g0 * (1.0 - 2.0 / kA * (1.0 + kF * (1.0 - 2.0 * s2) + m) * h + 3.0 * h * h / (kA * kA));
+    const P g_N = -8.08e-9 * h * Sin(2.0 * l.L);
+    return {g_N, Splat(0.0), g_D};
+  }
+
+  // Row i of Eigen's Matrix3d * Vector3d from its three products: rows 0 and 1 are evaluated as
+  // one two-lane packet accumulated column by column, (a0 + a1) + a2; row 2 as a scalar unrolled
+  // reduction, a0 + (a1 + a2) (measured on Eigen 3.4 at -O2, SSE2).
+  template <typename T>
+  static T Dot3(int row, T a0, T a1, T a2) {
+    return row < 2 ? (a0 + a1) + a2 : a0 + (a1 + a2);
+  }
+
+  // ---- Sensor error step (TriadErrorSimulator::Apply<true>)
+  // -------------------------------------- `ideal` and `additive` are the same for every lane (the
+  // shared truth); the result per lane.
+  static V3 TriadStep(const TriadParams& p, TriadLanes& t, const double ideal[3],
+                      const double additive[3], uint64_t k, int j_block, uint64_t block_begin,
+                      double dt) {
+    double out[3][W];
+    const double weight = dt;
+    for (int i = 0; i < 3; ++i) {
+      const P m0 = Load(t.scale_misalignment[i][0]);
+      const P m1 = Load(t.scale_misalignment[i][1]);
+      const P m2 = Load(t.scale_misalignment[i][2]);
+      P y = Dot3(i, m0 * ideal[0], m1 * ideal[1], m2 * ideal[2]) + additive[i];
+      if (p.asymmetry) y = y + p.half_asymmetry[i] * __builtin_fabs(ideal[i]);
+      P e = Load(t.constant_bias[i]) * weight;
+      if (p.white) e = e + p.white_increment * Load(t.white[i][j_block]);
+      if (p.gauss_markov) {
+        const P w1 = Load(t.gm_w1[i][j_block]);
+        const P b = Load(t.gm_state[i]);
+        e = e + (p.gm_mean_gain * b + p.gm_integral_w1_gain * w1 +
+                 p.gm_integral_w2_gain * Load(t.gm_w2[i][j_block]));
+        Store(t.gm_state[i], p.gm_decay * b + p.gm_drive_sigma * w1);
+      }
+      if (p.random_walk) {
+        const P step = p.rw_step_sigma * Load(t.rw_w1[i][j_block]);
+        const P b = Load(t.rw_state[i]);
+        e = e + (b * dt + 0.5 * dt * step + p.rw_bridge_sigma * Load(t.rw_w2[i][j_block]));
+        Store(t.rw_state[i], b + step);
+      }
+      if (p.n_flicker > 0) {
+        P sum = Splat(0.0);
+        for (int j = 0; j < p.n_flicker; ++j) {
+          const int m = p.flicker_period_log2[j];
+          const uint64_t mask = (uint64_t{1} << m) - 1;
+          P x = Load(t.flicker_state[i][j]);
+          if (k != 0 && (k & mask) == 0) {
+            x = p.flicker_decay[j] * x +
+                p.flicker_drive_sigma[j] * Load(t.flicker_w[i][j][(k - block_begin) >> m]);
+            Store(t.flicker_state[i][j], x);
+          }
+          sum = sum + x;
+        }
+        e = e + sum * weight;
+      }
+      P v = y + e;
+      if (p.range > 0.0) {
+        const double lo = -p.range * weight, hi = p.range * weight;
+        for (int l = 0; l < W; ++l) v[l] = v[l] < lo ? lo : (hi < v[l] ? hi : v[l]);
+      }
+      if (p.quantization > 0.0) {
+        const double lsb = p.quantization;
+        const P carried = v + Load(t.remainder[i]);
+        P q = carried / lsb + 0.5;
+        for (int l = 0; l < W; ++l) q[l] = __builtin_floor(q[l]);
+        const P o = lsb * q;
+        Store(t.remainder[i], carried - o);
+        v = o;
+      }
+      Store(out[i], v);
+    }
+    return {Load(out[0]), Load(out[1]), Load(out[2])};
+  }
+
+  // ---- Mechanization (NedMechanization::Update / Propagate)
+  // ---------------------------------------
+  struct Step {
+    P L, lon, h;
+    V3 v, zeta;
+  };
+
+  static Step Propagate(const KernelJob& job, const Q4& q, const P& L, const P& lon, const P& h,
+                        const V3& v_old, const V3& delta_v_b, const V3& alpha_cross_dv,
+                        const V3& second_order_b, const V3& llh_rate_old, const P& L_mid,
+                        const P& h_mid, const V3& v_mid) {
+    const double dt = job.dt_s;
+    const EarthParams& e = job.earth;
+    const Lat lat_mid = LatOf(L_mid);
+    Step s;
+    const V3 omega_ie_n = EarthRate(e, lat_mid);
+    const V3 omega_en_n = TransportRate(e, lat_mid, h_mid, v_mid);
+    s.zeta = Scale(Add(omega_ie_n, omega_en_n), dt);
+    const V3& zeta = s.zeta;
+    const V3 u = Rotate(q, delta_v_b);
+    const V3 delta_v_sf_n =
+        Add(Sub(Sub(Add(u, Rotate(q, second_order_b)), Scale(0.5, Cross(zeta, u))),
+                Div(Cross(zeta, Rotate(q, alpha_cross_dv)), 12.0)),
+            Div(Cross(zeta, Cross(zeta, u)), 6.0));
+    const V3 g_b_n = Gravity(e, lat_mid, h_mid);
+    s.v = Add(Add(v_old, delta_v_sf_n),
+              Scale(Sub(g_b_n, Cross(Add(omega_en_n, Scale(2.0, omega_ie_n)), v_mid)), dt));
+    // TrapezoidPosition (ins.cc).
+    const P L_new_predicted = 2.0 * L_mid - L;
+    const P h_new = h - 0.5 * dt * (v_old.z + s.v.z);
+    const V3 rate_new = LlhRate(e, LatOf(L_new_predicted), h_new, s.v);
+    s.L = L + 0.5 * dt * (llh_rate_old.x + rate_new.x);
+    s.lon = lon + 0.5 * dt * (llh_rate_old.y + rate_new.y);
+    s.h = h_new;
+    return s;
+  }
+
+  static void NedStep(const KernelJob& job, NavLanes& n, const V3& dtheta, const V3& dv) {
+    const double dt = job.dt_s;
+    V3 alpha = dtheta;
+    V3 delta_v_b = dv;
+    V3 alpha_cross_dv = Splat3(0.0, 0.0, 0.0);
+    V3 second_order_b = Splat3(0.0, 0.0, 0.0);
+    const V3 previous_dtheta = Load3(n.previous_dtheta);
+    const V3 previous_dv = Load3(n.previous_dv);
+    if (job.coning_sculling) {
+      alpha_cross_dv = Cross(dtheta, dv);
+      second_order_b = Div(Cross(dtheta, alpha_cross_dv), 6.0);
+      delta_v_b = Add(delta_v_b, Scale(0.5, alpha_cross_dv));
+      if (n.have_previous) {
+        alpha = Add(alpha, Div(Cross(previous_dtheta, dtheta), 12.0));
+        delta_v_b =
+            Add(delta_v_b, Div(Add(Cross(previous_dtheta, dv), Cross(previous_dv, dtheta)), 12.0));
+      }
+    }
+    const P L = Load(n.lat_rad), lon = Load(n.lon_rad), h = Load(n.h_m);
+    const V3 v = Load3(n.v_eb_n);
+    const V3 previous_v = Load3(n.previous_v_eb_n);
+    const Q4 q{Load(n.q_b_n[0]), Load(n.q_b_n[1]), Load(n.q_b_n[2]), Load(n.q_b_n[3])};
+    const V3 v_mid_predicted = n.have_previous ? Sub(Scale(1.5, v), Scale(0.5, previous_v)) : v;
+    const Lat lat = LatOf(L);
+    const V3 llh_rate_old = LlhRate(job.earth, lat, h, v);
+    const V3 llh_rate_mid = LlhRate(job.earth, lat, h, v_mid_predicted);
+    const Step predicted =
+        Propagate(job, q, L, lon, h, v, delta_v_b, alpha_cross_dv, second_order_b, llh_rate_old,
+                  L + 0.5 * dt * llh_rate_mid.x, h + 0.5 * dt * llh_rate_mid.z, v_mid_predicted);
+    const Step corrected = Propagate(job, q, L, lon, h, v, delta_v_b, alpha_cross_dv,
+                                     second_order_b, llh_rate_old, 0.5 * (L + predicted.L),
+                                     0.5 * (h + predicted.h), Scale(0.5, Add(v, predicted.v)));
+    const V3 minus_zeta{-corrected.zeta.x, -corrected.zeta.y, -corrected.zeta.z};
+    const Q4 q_new = Normalized(
+        Mul(Mul(RotationVectorToQuaternion(minus_zeta), q), RotationVectorToQuaternion(alpha)));
+    Store(n.q_b_n[0], q_new.w);
+    Store(n.q_b_n[1], q_new.x);
+    Store(n.q_b_n[2], q_new.y);
+    Store(n.q_b_n[3], q_new.z);
+    Store3(n.previous_v_eb_n, v);
+    Store3(n.previous_dtheta, dtheta);
+    Store3(n.previous_dv, dv);
+    Store(n.lat_rad, corrected.L);
+    Store(n.lon_rad, corrected.lon);
+    Store(n.h_m, corrected.h);
+    Store3(n.v_eb_n, corrected.v);
+  }
+
+  // Sample k (increment over (t_{k-1}, t_k]) is the sensor's step d = k - 1 (its deviate index,
+  // TriadErrorSimulator::step()); the block holds the deviates of steps [block_begin, +kBlock).
+  static void Advance(const KernelJob& job, const KernelInputs& in, int64_t k_begin, int64_t k_end,
+                      bool navigate, LockstepGroup* group) {
+    const uint64_t block_begin = static_cast<uint64_t>(k_begin - 1) & ~uint64_t{kBlock - 1};
+    NavLanes& n = group->nav;
+    for (int64_t k = k_begin; k < k_end; ++k) {
+      const double* ideal = in.increments + 6 * k;
+      V3 dtheta, dv;
+      if (job.has_sensor) {
+        const uint64_t d = static_cast<uint64_t>(k - 1);
+        const int j = static_cast<int>(d - block_begin);
+        double g_term[3] = {0.0, 0.0, 0.0};
+        if (job.g_sensitivity) {
+          for (int i = 0; i < 3; ++i) {
+            const double* G = job.gyro_g_sensitivity[i];
+            g_term[i] = Dot3(i, G[0] * ideal[3], G[1] * ideal[4], G[2] * ideal[5]);
+          }
+        }
+        const double zero[3] = {0.0, 0.0, 0.0};
+        dtheta =
+            TriadStep(job.triad[0], group->triad[0], ideal, g_term, d, j, block_begin, job.dt_s);
+        dv = TriadStep(job.triad[1], group->triad[1], ideal + 3, zero, d, j, block_begin, job.dt_s);
+      } else {
+        dtheta = Splat3(ideal[0], ideal[1], ideal[2]);
+        dv = Splat3(ideal[3], ideal[4], ideal[5]);
+      }
+      if (!navigate) {
+        Store3(n.sum_dtheta, Add(Load3(n.sum_dtheta), dtheta));
+        Store3(n.sum_dv, Add(Load3(n.sum_dv), dv));
+        continue;
+      }
+      NedStep(job, n, dtheta, dv);
+      n.have_previous = 1;
+      ++n.steps;
+      if (job.truth_height) {
+        Store(n.h_m, Splat(in.h_m[k]));
+        Store(n.v_eb_n[2], Splat(in.v_D_m_per_s[k]));
+      }
+    }
+  }
+};
+
+}  // namespace
+}  // namespace driftlab::lockstep
