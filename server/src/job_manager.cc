@@ -714,28 +714,7 @@ void JobManager::RunClusterJob(const std::shared_ptr<LiveJob>& live) {
   } catch (const std::exception& e) {
     error = std::string("internal error: ") + MessageText(e.what(), kMaxMessageTextBytes);
   }
-  if (requeue) {
-    store_->Requeue(id);
-  } else if (final_state != v1::SUCCEEDED) {
-    store_->MarkFinished(id, final_state, error, UnixNow());
-  }
-  const double seconds = std::chrono::duration<double>(SteadyClock::now() - live->started).count();
-  std::lock_guard lock(mutex_);
-  samples_finished_ += static_cast<uint64_t>(live->progress.samples_done);
-  live_.erase(id);
-  changed_.notify_all();
-  if (requeue) {
-    spdlog::info(
-        "job={} owner={} state=QUEUED runs={} seconds={:.3f} (shutdown; its shards keep "
-        "running)",
-        id, live->row.owner, runs, seconds);
-  } else if (final_state == v1::SUCCEEDED) {
-    spdlog::info("job={} owner={} state=SUCCEEDED runs={} seconds={:.3f}", id, live->row.owner,
-                 runs, seconds);
-  } else {
-    spdlog::info("job={} owner={} state={} runs={} seconds={:.3f} error=\"{}\"", id,
-                 live->row.owner, v1::JobState_Name(final_state), runs, seconds, error);
-  }
+  FinishJob(live, final_state, requeue, error, "shutdown; its shards keep running");
 }
 
 void JobManager::RunJob(const std::shared_ptr<LiveJob>& live) {
@@ -782,26 +761,34 @@ void JobManager::RunJob(const std::shared_ptr<LiveJob>& live) {
   } catch (const std::exception& e) {
     error = std::string("internal error: ") + MessageText(e.what(), kMaxMessageTextBytes);
   }
+  FinishJob(live, final_state, requeue, error, "stopped by shutdown");
+}
+
+// The end of a job, in-process or on a cluster: the store's final state (or back to the queue on
+// shutdown), the server's sample count, the live entry removed, one log line.
+void JobManager::FinishJob(const std::shared_ptr<LiveJob>& live, v1::JobState final_state,
+                           bool requeue, const std::string& error, std::string_view requeue_note) {
+  const std::string& id = live->row.id;
   if (requeue) {
     store_->Requeue(id);
   } else if (final_state != v1::SUCCEEDED) {
     store_->MarkFinished(id, final_state, error, UnixNow());
   }
   const double seconds = std::chrono::duration<double>(SteadyClock::now() - live->started).count();
+  const uint32_t runs = live->row.runs_total;
   std::lock_guard lock(mutex_);
   samples_finished_ += static_cast<uint64_t>(live->progress.samples_done);
   live_.erase(id);
   changed_.notify_all();
   if (requeue) {
-    spdlog::info("job={} owner={} state=QUEUED runs={} seconds={:.3f} (stopped by shutdown)", id,
-                 live->row.owner, live->row.runs_total, seconds);
+    spdlog::info("job={} owner={} state=QUEUED runs={} seconds={:.3f} ({})", id, live->row.owner,
+                 runs, seconds, requeue_note);
   } else if (final_state == v1::SUCCEEDED) {
     spdlog::info("job={} owner={} state=SUCCEEDED runs={} seconds={:.3f}", id, live->row.owner,
-                 live->row.runs_total, seconds);
+                 runs, seconds);
   } else {
     spdlog::info("job={} owner={} state={} runs={} seconds={:.3f} error=\"{}\"", id,
-                 live->row.owner, v1::JobState_Name(final_state), live->row.runs_total, seconds,
-                 error);
+                 live->row.owner, v1::JobState_Name(final_state), runs, seconds, error);
   }
 }
 

@@ -727,6 +727,33 @@ TEST(Report, IsOneSelfContainedFileWithAnInteractivePlotEach) {
   EXPECT_NE(short_html.find("keeps no per-run values"), std::string::npos);
 }
 
+// Issue 18: with a covariance analysis, the summary table shows the predicted sigma (RMS for the
+// two distances) beside the Monte-Carlo sigma; without one, no such column.
+TEST(Report, SummaryTableShowsThePredictedSigmaWhenTheResultHasACovarianceAnalysis) {
+  v1::JobResult result = MakeResult(1.0, 50);
+  const std::string without = RenderHtmlReport(result);
+  EXPECT_EQ(without.find("<th>predicted &sigma;</th>"), std::string::npos);
+  v1::CovarianceAnalysis* covariance = result.mutable_covariance();
+  covariance->set_filter("NONE");
+  for (const v1::EpochStatistics& epoch : result.epochs()) {
+    v1::PredictedEpoch* predicted = covariance->add_epochs();
+    predicted->set_t_s(epoch.t_s());
+    // Distinct, recognisable values: 0.001 (c + 1) * 7 for component c.
+    for (int c = 0; c < kErrorComponentCount; ++c) predicted->add_sigma(0.007 * (c + 1));
+  }
+  const std::string with = RenderHtmlReport(result);
+  const size_t header = with.find("<th>predicted &sigma;</th>");
+  ASSERT_NE(header, std::string::npos);
+  // The column sits between the sigma interval and the RMS in the summary table.
+  EXPECT_LT(with.find("<th>&sigma; 95 % CI</th>", header - 40), header);
+  EXPECT_EQ(with.find("<th>RMS</th>", header), header + std::strlen("<th>predicted &sigma;</th>"));
+  // North position (c = 0) and the 3-D distance (c = 10) rows carry their predicted value.
+  const size_t north = with.find("<tr><td>north position", header);
+  ASSERT_NE(north, std::string::npos);
+  const std::string north_row = with.substr(north, with.find("</tr>", north) - north);
+  EXPECT_NE(north_row.find("0.007"), std::string::npos) << north_row;
+}
+
 TEST(Report, DataFileResultRendersAndIsWellFormedXml) {
   // The committed synthetic result (tests/cli/data/gate_make_results.py): its markup (script
   // text removed) must be well formed; Python's XML parser reads the report body after the doctype

@@ -576,25 +576,36 @@ std::string ScatterPlot(const v1::Checkpoint& checkpoint) {
 std::string SummaryTable(const v1::JobResult& result) {
   const v1::EpochStatistics& epoch = *result.epochs().rbegin();
   const v1::Checkpoint& checkpoint = *result.checkpoints().rbegin();
+  // The covariance analysis' prediction at the same epoch, when the result has one (issue 18):
+  // sigma for the 9 components, RMS for the two distances.
+  const v1::PredictedEpoch* predicted = nullptr;
+  if (result.has_covariance() && result.covariance().epochs_size() > 0) {
+    const v1::PredictedEpoch& last = *result.covariance().epochs().rbegin();
+    if (last.t_s() == epoch.t_s() && last.sigma_size() >= kErrorComponentCount) predicted = &last;
+  }
   std::string out = fmt::format(
       "<table><caption>Final epoch, t = {} s, {} runs (95 % confidence intervals in "
-      "brackets; percentiles of |error|; each row in one fixed format)</caption>\n<tr>"
-      "<th>component</th><th>unit</th><th>mean</th><th>&sigma;</th><th>&sigma; 95 % CI</th>"
+      "brackets; percentiles of |error|; each row in one fixed format{})</caption>\n<tr>"
+      "<th>component</th><th>unit</th><th>mean</th><th>&sigma;</th><th>&sigma; 95 % CI</th>{}"
       "<th>RMS</th><th>RMS 95 % CI</th><th>p50</th><th>p68</th><th>p95</th><th>p99</th>"
       "<th>max</th></tr>\n",
-      Num(epoch.t_s()), result.run_count());
+      Num(epoch.t_s()), result.run_count(),
+      predicted ? "; predicted: the covariance analysis' sigma, its RMS for the distances" : "",
+      predicted ? "<th>predicted &sigma;</th>" : "");
   for (int c = 0; c < kErrorComponentCount; ++c) {
     const v1::ComponentStatistics& s = epoch.components(c);
     const v1::ComponentPercentiles& p = checkpoint.components(c);
     const RowFormat f{s.mean(),          s.std(),           s.rms(),
                       s.rms_ci95_high(), s.std_ci95_high(), p.max_abs()};
+    const std::string predicted_cell =
+        predicted ? fmt::format("<td class=\"num\">{}</td>", f(predicted->sigma(c))) : "";
     out += fmt::format(
         "<tr><td>{}</td><td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
-        "<td class=\"num\">[{}, {}]</td><td class=\"num\">{}</td><td class=\"num\">[{}, {}]</td>"
+        "<td class=\"num\">[{}, {}]</td>{}<td class=\"num\">{}</td><td class=\"num\">[{}, {}]</td>"
         "<td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>"
         "<td class=\"num\">{}</td><td class=\"num\">{}</td></tr>\n",
         kComponentNames[c], ComponentUnit(Component(c)), f(s.mean()), f(s.std()),
-        f(s.std_ci95_low()), f(s.std_ci95_high()), f(s.rms()), f(s.rms_ci95_low()),
+        f(s.std_ci95_low()), f(s.std_ci95_high()), predicted_cell, f(s.rms()), f(s.rms_ci95_low()),
         f(s.rms_ci95_high()), f(p.p50()), f(p.p68()), f(p.p95()), f(p.p99()), f(p.max_abs()));
   }
   out += "</table>\n";

@@ -35,6 +35,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -120,6 +121,8 @@ class JobManager {
   void RunJob(const std::shared_ptr<LiveJob>& live);
   // RunJob for a job on the cluster (cluster.h); runs on a thread of its own.
   void RunClusterJob(const std::shared_ptr<LiveJob>& live);
+  void FinishJob(const std::shared_ptr<LiveJob>& live, v1::JobState final_state, bool requeue,
+                 const std::string& error, std::string_view requeue_note);
   // True when the job runs on the cluster: a backend is configured and the job is over its
   // threshold (and not itself a shard), or it was handed to the cluster before a restart.
   bool UsesCluster(const StoredJob& row) const;
