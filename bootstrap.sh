@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # Installs every Debian 12 package driftlab's build, tests and clients need.
 # Non-interactive and idempotent: packages already installed are left alone.
+# `bash bootstrap.sh --only LABEL PACKAGE...` installs those packages the same way instead
+# (scripts/ci-packages.sh: the packages only CI's tests need).
 set -euo pipefail
 
+label=bootstrap
 packages=(
   build-essential cmake ninja-build pkg-config git ca-certificates
   libeigen3-dev libceres-dev libtbb-dev
@@ -13,6 +16,11 @@ packages=(
   clang-format ccache
   libjs-dygraphs
 )
+if [ "${1:-}" = "--only" ]; then
+  label="$2"
+  shift 2
+  packages=("$@")
+fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -22,12 +30,12 @@ for p in "${packages[@]}"; do
 done
 
 if [ ${#missing[@]} -eq 0 ]; then
-  echo "bootstrap: all ${#packages[@]} packages present"
+  echo "${label}: all ${#packages[@]} packages present"
   exit 0
 fi
 
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-echo "bootstrap: installing ${missing[*]}"
+echo "${label}: installing ${missing[*]}"
 $SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -qq
 $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -5,21 +5,9 @@
 # about 12 s to install on the development machine). Non-interactive and idempotent, as bootstrap.sh.
 set -euo pipefail
 packages=(slurm-wlm munge clang-14 libclang-rt-14-dev chromium)
-missing=()
-for p in "${packages[@]}"; do
-  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
-    missing+=("$p")
-  fi
-done
-if [ ${#missing[@]} -eq 0 ]; then
-  echo "ci-packages: all ${#packages[@]} packages present"
-  exit 0
-fi
+bash "$(dirname "$0")/../bootstrap.sh" --only ci-packages "${packages[@]}"
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-echo "ci-packages: installing ${missing[*]}"
-$SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -qq
-$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}"
 # The Debian packages start munge and Slurm's own daemons: the test starts its own, on other
 # ports and sockets; stop the system ones so that nothing else runs jobs here.
 for service in slurmctld slurmd munge; do
