@@ -1,6 +1,7 @@
 // Lockstep free-inertial NED throughput per instruction-set path (issue 17): IMU samples per
 // second on one core for the scalar one-run-at-a-time reference (DRIFTLAB_ISA=scalar) and each
-// lockstep path the CPU has (baseline, avx2, avx512), for two sensor models:
+// lockstep path the CPU has (baseline, avx2, avx512), for three sensor models:
+//   * white noise only on all 6 axes;
 //   * white + Gauss-Markov + random walk on all 6 axes (no other term);
 //   * the tactical preset (presets.h: every term it has, incl. flicker, scale factor,
 //     misalignment, turn-on bias, range).
@@ -62,6 +63,14 @@ ImuErrorModel WhiteGaussMarkovRandomWalk() {
   return m;
 }
 
+// White noise only on all 6 axes (the static gnss-ins-sim comparison's model).
+ImuErrorModel WhiteOnly() {
+  ImuErrorModel m;
+  m.gyro.white_noise_density = 1e-4;
+  m.accel.white_noise_density = 1e-3;
+  return m;
+}
+
 const char* kPaths[] = {"scalar", "baseline", "avx2", "avx512"};
 
 bool PathAvailable(const std::string& path) {
@@ -100,11 +109,13 @@ void Run(benchmark::State& state, const ImuErrorModel& model) {
   state.counters["truth_fraction"] = truth_s / wall_s;
 }
 
+void BM_NedWhiteOnly(benchmark::State& state) { Run(state, WhiteOnly()); }
 void BM_NedWhiteGaussMarkovRandomWalk(benchmark::State& state) {
   Run(state, WhiteGaussMarkovRandomWalk());
 }
 void BM_NedTactical(benchmark::State& state) { Run(state, FindImuPreset("tactical")); }
 
+BENCHMARK(BM_NedWhiteOnly)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_NedWhiteGaussMarkovRandomWalk)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_NedTactical)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
 

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <vector>
 
@@ -70,6 +71,40 @@ TEST(PolynomialMathTest, SinCosOfTwoPiUMatchLongDoubleWithinFewUlp) {
   EXPECT_NEAR(c, -std::numbers::sqrt2 / 2, 2e-16);
 }
 
+TEST(PolynomialMathTest, SinCosOfGeneralArgumentMatchLongDoubleWithinFewUlp) {
+  // Cody-Waite reduction with pi/2 to ~2^-151 leaves t within ~1e-16 ulp of exact for
+  // |x| < 1.6e6; the Taylor sums then add the same few 1e-17 as above: 3e-16 absolute.
+  // Latitudes, angles up to 4 rad, and large arguments up to 1e5 rad.
+  double max_error = 0.0;
+  for (int range = 0; range < 3; ++range) {
+    const double half_width = range == 0 ? 1.6 : (range == 1 ? 4.0 : 1e5);
+    for (int i = -50000; i <= 50000; ++i) {
+      const double x = half_width * (static_cast<double>(i) / 50000.0) + 1e-7 * (i % 7);
+      double s = 0.0, c = 0.0;
+      PolySinCos(x, &s, &c);
+      const long double xl = x;
+      max_error = std::max(max_error, std::fabs(s - static_cast<double>(std::sin(xl))));
+      max_error = std::max(max_error, std::fabs(c - static_cast<double>(std::cos(xl))));
+    }
+  }
+  EXPECT_LT(max_error, 3e-16);
+  // Small arguments keep their relative accuracy (sin x = x - x^3/6 to 1 ulp).
+  for (double x : {1e-300, -3e-20, 1e-9, 2.5e-5}) {
+    double s = 0.0, c = 0.0;
+    PolySinCos(x, &s, &c);
+    EXPECT_NEAR(s, x - x * x * x / 6.0, 2.3e-16 * std::fabs(x)) << x;
+    EXPECT_NEAR(c, 1.0 - x * x / 2.0, 1.2e-16) << x;
+  }
+  double s = 0.0, c = 0.0;
+  PolySinCos(0.0, &s, &c);
+  EXPECT_EQ(s, 0.0);
+  EXPECT_EQ(c, 1.0);
+  PolySinCos(std::numeric_limits<double>::quiet_NaN(), &s, &c);
+  EXPECT_TRUE(std::isnan(s) && std::isnan(c));
+  PolySinCos(std::numeric_limits<double>::infinity(), &s, &c);
+  EXPECT_TRUE(std::isnan(s) && std::isnan(c));
+}
+
 std::vector<double> Draw(const RandomStream& stream, uint64_t first, size_t n) {
   std::vector<double> z(n);
   stream.FillGaussian(first, z);
@@ -77,9 +112,9 @@ std::vector<double> Draw(const RandomStream& stream, uint64_t first, size_t n) {
 }
 
 TEST(GaussianTest, MomentsMatchStandardNormal) {
-  // n = 4e6: standard errors of mean, variance, skewness, excess kurtosis are sqrt(1/n),
+  // n = 1e7: standard errors of mean, variance, skewness, excess kurtosis are sqrt(1/n),
   // sqrt(2/n), sqrt(6/n), sqrt(24/n) (normal theory); each is checked at kZ standard errors.
-  const size_t n = 4'000'000;
+  const size_t n = 10'000'000;
   const std::vector<double> z =
       Draw(RandomStream(2024, 7, {SensorId::kGyro, 1, ErrorTerm::kWhiteNoise, 0}), 0, n);
   long double m1 = 0, m2 = 0, m3 = 0, m4 = 0;
@@ -101,26 +136,64 @@ TEST(GaussianTest, MomentsMatchStandardNormal) {
   EXPECT_NEAR(kurt, 0.0, kZ * std::sqrt(24.0 / nd));
 }
 
+// 1e7 deviates of one stream, sorted, with their standard normal CDF values (the KS and
+// Anderson-Darling tests share them: drawing, sorting and evaluating erfc take ~2 s).
+struct SortedDraws {
+  std::vector<double> z, lower_cdf, upper_cdf;  // F(z_i) and 1 - F(z_i), each accurate in its tail
+};
+const SortedDraws& TenMillionSorted() {
+  static const SortedDraws draws = [] {
+    SortedDraws d;
+    d.z = Draw(RandomStream(99, 0, {SensorId::kAccel, 2, ErrorTerm::kRandomWalk, 0}), 12345,
+               10'000'000);
+    std::sort(d.z.begin(), d.z.end());
+    d.lower_cdf.resize(d.z.size());
+    d.upper_cdf.resize(d.z.size());
+    for (size_t i = 0; i < d.z.size(); ++i) {
+      d.lower_cdf[i] = 0.5 * std::erfc(-d.z[i] / std::numbers::sqrt2);
+      d.upper_cdf[i] = 0.5 * std::erfc(d.z[i] / std::numbers::sqrt2);
+    }
+    return d;
+  }();
+  return draws;
+}
+
 TEST(GaussianTest, KolmogorovSmirnovAgainstStandardNormal) {
   // Asymptotic Kolmogorov critical value sqrt(-ln(alpha/2) / 2) / sqrt(n) = 1.949 / sqrt(n) at
-  // alpha = 1e-3 (n = 1e6: 1.95e-3).
-  const size_t n = 1'000'000;
-  std::vector<double> z =
-      Draw(RandomStream(99, 0, {SensorId::kAccel, 2, ErrorTerm::kRandomWalk, 0}), 12345, n);
-  std::sort(z.begin(), z.end());
-  double d = 0.0;
+  // alpha = 1e-3 (n = 1e7: 6.16e-4).
+  const SortedDraws& d = TenMillionSorted();
+  const size_t n = d.z.size();
+  double stat = 0.0;
   for (size_t i = 0; i < n; ++i) {
-    const double cdf = 0.5 * std::erfc(-z[i] / std::numbers::sqrt2);
-    d = std::max({d, cdf - static_cast<double>(i) / n, static_cast<double>(i + 1) / n - cdf});
+    const double cdf = d.lower_cdf[i];
+    stat = std::max({stat, cdf - static_cast<double>(i) / n, static_cast<double>(i + 1) / n - cdf});
   }
-  EXPECT_LT(d, 1.949 / std::sqrt(static_cast<double>(n)));
+  EXPECT_LT(stat, 1.949 / std::sqrt(static_cast<double>(n)));
+}
+
+TEST(GaussianTest, AndersonDarlingAgainstStandardNormal) {
+  // A^2 = -n - (1/n) sum_i (2i - 1) [ln F(z_(i)) + ln(1 - F(z_(n+1-i)))] for the fully specified
+  // N(0, 1) (case 0). Its asymptotic upper 1 % point is 3.857 (M. A. Stephens, "EDF statistics
+  // for goodness of fit and some comparisons", JASA 69 (1974) 730, Table 1A, case 0); A^2 weighs
+  // the tails, where the Box-Muller log and the 32-bit uniforms matter. Seed fixed in advance.
+  const SortedDraws& d = TenMillionSorted();
+  const size_t n = d.z.size();
+  long double sum = 0.0L;
+  for (size_t i = 0; i < n; ++i) {
+    sum += static_cast<long double>(2 * i + 1) *
+           (std::log(static_cast<long double>(d.lower_cdf[i])) +
+            std::log(static_cast<long double>(d.upper_cdf[n - 1 - i])));
+  }
+  const double a2 = static_cast<double>(-static_cast<long double>(n) - sum / n);
+  EXPECT_LT(a2, 3.857);
+  EXPECT_GT(a2, 0.0);
 }
 
 TEST(GaussianTest, TailProbabilitiesMatchStandardNormal) {
   // Counts beyond |z| > 3 and > 4 are binomial(n, p) with p = erfc(3/sqrt2) = 2.700e-3 and
   // erfc(4/sqrt2) = 6.334e-5; checked at kZ binomial standard deviations. Exercises the log in
   // Box-Muller where u1 is small. Also |z| <= 6.67, the bound set by 32-bit uniforms.
-  const size_t n = 4'000'000;
+  const size_t n = 10'000'000;
   const std::vector<double> z =
       Draw(RandomStream(5, 3, {SensorId::kGyro, 0, ErrorTerm::kGaussMarkov, 0}), 0, n);
   for (double threshold : {3.0, 4.0}) {

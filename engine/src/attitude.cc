@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "lane_math.h"
+
 namespace driftlab {
 
 Matrix3d Skew(const Vector3d& a) {
@@ -42,8 +44,10 @@ Matrix3d RotationVectorToDcm(const Vector3d& rho) {
     s = 1.0 - a2 / 6.0 + a2 * a2 / 120.0;
     c = 0.5 - a2 / 24.0 + a2 * a2 / 720.0;
   } else {
-    s = std::sin(a) / a;
-    c = (1.0 - std::cos(a)) / a2;
+    double sin_a, cos_a;
+    lane_math::SinCos<1>(a, sin_a, cos_a);
+    s = sin_a / a;
+    c = (1.0 - cos_a) / a2;
   }
   const Matrix3d K = Skew(rho);
   return Matrix3d::Identity() + s * K + c * K * K;
@@ -57,8 +61,10 @@ Quaterniond RotationVectorToQuaternion(const Vector3d& rho) {
     w = 1.0 - a2 / 8.0 + a2 * a2 / 384.0;
     k = 0.5 - a2 / 48.0 + a2 * a2 / 3840.0;
   } else {
-    w = std::cos(0.5 * a);
-    k = std::sin(0.5 * a) / a;
+    double sin_half, cos_half;  // the engine's own (lane_math.h), as the lockstep kernels
+    lane_math::SinCos<1>(0.5 * a, sin_half, cos_half);
+    w = cos_half;
+    k = sin_half / a;
   }
   return Quaterniond(w, k * rho.x(), k * rho.y(), k * rho.z());
 }

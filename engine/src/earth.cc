@@ -2,16 +2,34 @@
 
 #include <cmath>
 
+#include "lane_math.h"
+
 namespace driftlab {
 
+namespace {
+
+// The engine's own sin and cos (lane_math.h): the lockstep kernels compute the same bits.
+double Sin(double x) {
+  double s, c;
+  lane_math::SinCos<1>(x, s, c);
+  return s;
+}
+double Cos(double x) {
+  double s, c;
+  lane_math::SinCos<1>(x, s, c);
+  return c;
+}
+
+}  // namespace
+
 double MeridianRadius(double L_b) {
-  const double s = std::sin(L_b);
+  const double s = Sin(L_b);
   const double d = 1.0 - kWgs84Eccentricity2 * s * s;
   return kWgs84SemiMajorAxis_m * (1.0 - kWgs84Eccentricity2) / (d * std::sqrt(d));
 }
 
 double TransverseRadius(double L_b) {
-  const double s = std::sin(L_b);
+  const double s = Sin(L_b);
   return kWgs84SemiMajorAxis_m / std::sqrt(1.0 - kWgs84Eccentricity2 * s * s);
 }
 
@@ -20,14 +38,14 @@ double SomiglianaGravity(double L_b) {
   const double k = kWgs84SemiMinorAxis_m * kWgs84GammaPole_m_per_s2 /
                        (kWgs84SemiMajorAxis_m * kWgs84GammaEquator_m_per_s2) -
                    1.0;
-  const double s2 = std::sin(L_b) * std::sin(L_b);
+  const double s2 = Sin(L_b) * Sin(L_b);
   return kWgs84GammaEquator_m_per_s2 * (1.0 + k * s2) / std::sqrt(1.0 - kWgs84Eccentricity2 * s2);
 }
 
 Vector3d GravityNed(double L_b, double h_b) {
   const double a = kWgs84SemiMajorAxis_m;
   const double f = kWgs84Flattening;
-  const double s2 = std::sin(L_b) * std::sin(L_b);
+  const double s2 = Sin(L_b) * Sin(L_b);
   // m = omega_ie^2 a^2 b / mu, the ratio of centrifugal to gravitational acceleration at the
   // equator (NIMA TR8350.2 table 3.3: 0.00344978650684).
   const double m = kWgs84EarthRate_rad_per_s * kWgs84EarthRate_rad_per_s * a * a *
@@ -35,26 +53,26 @@ Vector3d GravityNed(double L_b, double h_b) {
   const double g0 = SomiglianaGravity(L_b);
   const double g_D =
       g0 * (1.0 - 2.0 / a * (1.0 + f * (1.0 - 2.0 * s2) + m) * h_b + 3.0 * h_b * h_b / (a * a));
-  const double g_N = -8.08e-9 * h_b * std::sin(2.0 * L_b);
+  const double g_N = -8.08e-9 * h_b * Sin(2.0 * L_b);
   return Vector3d(g_N, 0.0, g_D);
 }
 
 Vector3d EarthRateNed(double L_b) {
-  return Vector3d(kWgs84EarthRate_rad_per_s * std::cos(L_b), 0.0,
-                  -kWgs84EarthRate_rad_per_s * std::sin(L_b));
+  return Vector3d(kWgs84EarthRate_rad_per_s * Cos(L_b), 0.0,
+                  -kWgs84EarthRate_rad_per_s * Sin(L_b));
 }
 
 Vector3d TransportRateNed(double L_b, double h_b, const Vector3d& v_eb_n) {
   const double R_E = TransverseRadius(L_b) + h_b;
   const double R_N = MeridianRadius(L_b) + h_b;
-  return Vector3d(v_eb_n.y() / R_E, -v_eb_n.x() / R_N, -v_eb_n.y() * std::tan(L_b) / R_E);
+  return Vector3d(v_eb_n.y() / R_E, -v_eb_n.x() / R_N, -v_eb_n.y() * (Sin(L_b) / Cos(L_b)) / R_E);
 }
 
 Vector3d LlhToEcef(const Llh& llh) {
   const double R_E = TransverseRadius(llh.lat_rad);
-  const double cL = std::cos(llh.lat_rad), sL = std::sin(llh.lat_rad);
-  return Vector3d((R_E + llh.h_m) * cL * std::cos(llh.lon_rad),
-                  (R_E + llh.h_m) * cL * std::sin(llh.lon_rad),
+  const double cL = Cos(llh.lat_rad), sL = Sin(llh.lat_rad);
+  return Vector3d((R_E + llh.h_m) * cL * Cos(llh.lon_rad),
+                  (R_E + llh.h_m) * cL * Sin(llh.lon_rad),
                   ((1.0 - kWgs84Eccentricity2) * R_E + llh.h_m) * sL);
 }
 
@@ -74,10 +92,10 @@ Llh EcefToLlh(const Vector3d& r_eb_e) {
   const double ep2 = e2 / (1.0 - e2);
   const double u = std::atan2(z * a, p * b);
   double L =
-      std::atan2(z + ep2 * b * std::pow(std::sin(u), 3), p - e2 * a * std::pow(std::cos(u), 3));
+      std::atan2(z + ep2 * b * std::pow(Sin(u), 3), p - e2 * a * std::pow(Cos(u), 3));
   for (int i = 0; i < 8; ++i) {
     const double R_E = TransverseRadius(L);
-    const double L_next = std::atan2(z + e2 * R_E * std::sin(L), p);
+    const double L_next = std::atan2(z + e2 * R_E * Sin(L), p);
     const bool done = std::abs(L_next - L) < 1e-15;
     L = L_next;
     if (done) break;
@@ -85,17 +103,17 @@ Llh EcefToLlh(const Vector3d& r_eb_e) {
   llh.lat_rad = L;
   const double R_E = TransverseRadius(L);
   // Height: use the better-conditioned form away from the poles.
-  if (std::abs(std::cos(L)) > 1e-3) {
-    llh.h_m = p / std::cos(L) - R_E;
+  if (std::abs(Cos(L)) > 1e-3) {
+    llh.h_m = p / Cos(L) - R_E;
   } else {
-    llh.h_m = z / std::sin(L) - (1.0 - e2) * R_E;
+    llh.h_m = z / Sin(L) - (1.0 - e2) * R_E;
   }
   return llh;
 }
 
 Matrix3d EcefToNedDcm(double L_b, double lambda_b) {
-  const double sL = std::sin(L_b), cL = std::cos(L_b);
-  const double sl = std::sin(lambda_b), cl = std::cos(lambda_b);
+  const double sL = Sin(L_b), cL = Cos(L_b);
+  const double sl = Sin(lambda_b), cl = Cos(lambda_b);
   Matrix3d C_e_n;
   C_e_n << -sL * cl, -sL * sl, cL,  //
       -sl, cl, 0.0,                 //
@@ -154,7 +172,7 @@ Vector3d NavEnvironment::LlhRate(double L_b, double h_b, const Vector3d& v_eb_n)
     return Vector3d(v_eb_n.x() / flat_R_N_m_, v_eb_n.y() / flat_R_E_m_, -v_eb_n.z());
   }
   return Vector3d(v_eb_n.x() / (MeridianRadius(L_b) + h_b),
-                  v_eb_n.y() / ((TransverseRadius(L_b) + h_b) * std::cos(L_b)), -v_eb_n.z());
+                  v_eb_n.y() / ((TransverseRadius(L_b) + h_b) * Cos(L_b)), -v_eb_n.z());
 }
 
 Vector3d NavEnvironment::PositionErrorNed(const Llh& estimate, const Llh& truth) const {
@@ -168,7 +186,7 @@ Vector3d NavEnvironment::PositionErrorNed(const Llh& estimate, const Llh& truth)
   // First-order curvilinear-to-metre scaling, Groves (2.119); exact to ~1e-7 relative for the
   // position errors of interest (< 100 km).
   return Vector3d(dL * (MeridianRadius(truth.lat_rad) + truth.h_m),
-                  dlambda * (TransverseRadius(truth.lat_rad) + truth.h_m) * std::cos(truth.lat_rad),
+                  dlambda * (TransverseRadius(truth.lat_rad) + truth.h_m) * Cos(truth.lat_rad),
                   -dh);
 }
 

@@ -13,30 +13,24 @@
 //    3-vector as x0 + (x1 + x2) (its unrolled reduction halves the range), the quaternion product
 //    as its SSE2/NEON kernel (Geometry_SIMD.h), q * v as _transformVector, normalized() as division
 //    by sqrt of (x^2 + z^2) + (y^2 + w^2) (two-lane packets).
-// sin, cos and tan are called per lane through the C library (the scalar code's functions): the
-// first version keeps std:: there; the engine's own polynomials (DESIGN.md "Same bits
-// everywhere") would change today's bits and are left for a later step.
+// sin and cos are the engine's own (lane_math.h, also used by the scalar earth.cc and attitude.cc),
+// computed for all W lanes at once; tan L is sin L / cos L in both.
 #pragma once
 
-#include <math.h>
-
-#include <cmath>
 #include <cstdint>
 
+#include "lane_math.h"
 #include "lockstep_lanes.h"
 #include "random_kernels.h"
 
 namespace driftlab::lockstep {
 namespace {
 
-template <int W>
-struct LaneTypes {
-  typedef double P __attribute__((vector_size(W * sizeof(double))));
-};
 
 template <int W>
 struct Kernel {
-  using P = typename LaneTypes<W>::P;
+  using P = lane_math::D<W>;
+  using U = lane_math::U<W>;
 
   struct V3 {
     P x, y, z;
@@ -63,33 +57,14 @@ struct Kernel {
   }
   static V3 Splat3(double x, double y, double z) { return {Splat(x), Splat(y), Splat(z)}; }
 
-  static P Sqrt(P x) {
-    for (int i = 0; i < W; ++i) x[i] = __builtin_sqrt(x[i]);
-    return x;
-  }
-  // sin and cos of one argument in one sincos call where the C library has it (glibc computes
-  // both with the code of sin and cos, so the bits are theirs; lockstep_ned_test checks every
-  // path against the scalar code).
-  static void SinCos(double x, double* sin_x, double* cos_x) {
-#if defined(__GLIBC__)
-    ::sincos(x, sin_x, cos_x);
-#else
-    *sin_x = std::sin(x);
-    *cos_x = std::cos(x);
-#endif
-  }
+  static P Sqrt(P x) { return lane_math::Sqrt<W>(x); }
   static P Sin(P x) {
-    for (int i = 0; i < W; ++i) x[i] = std::sin(x[i]);
-    return x;
+    P s, c;
+    lane_math::SinCos<W>(x, s, c);
+    return s;
   }
-  static P Cos(P x) {
-    for (int i = 0; i < W; ++i) x[i] = std::cos(x[i]);
-    return x;
-  }
-  static P Tan(P x) {
-    for (int i = 0; i < W; ++i) x[i] = std::tan(x[i]);
-    return x;
-  }
+  // All-ones lanes where the comparison holds.
+  static U Mask(decltype(P{} < P{}) m) { return __builtin_bit_cast(U, m); }
 
   static V3 Add(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
   static V3 Sub(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
@@ -117,49 +92,28 @@ struct Kernel {
     r.w = (a.w * b.w - a.y * b.y) - (a.z * b.z + a.x * b.x);
     return r;
   }
-  // Eigen's normalized() of a Quaternion<double> (coeffs x, y, z, w in two-lane packets).
+  // Eigen's normalized() of a Quaternion<double> (coeffs x, y, z, w in two-lane packets); a zero
+  // quaternion is returned as it is.
   static Q4 Normalized(const Q4& q) {
     const P n2 = (q.x * q.x + q.z * q.z) + (q.y * q.y + q.w * q.w);
     const P n = Sqrt(n2);
-    Q4 r;
-    for (int i = 0; i < W; ++i) {
-      if (n2[i] > 0.0) {
-        r.w[i] = q.w[i] / n[i];
-        r.x[i] = q.x[i] / n[i];
-        r.y[i] = q.y[i] / n[i];
-        r.z[i] = q.z[i] / n[i];
-      } else {
-        r.w[i] = q.w[i];
-        r.x[i] = q.x[i];
-        r.y[i] = q.y[i];
-        r.z[i] = q.z[i];
-      }
-    }
-    return r;
+    const U positive = Mask(n2 > 0.0);
+    return {lane_math::Select<W>(positive, q.w / n, q.w),
+            lane_math::Select<W>(positive, q.x / n, q.x),
+            lane_math::Select<W>(positive, q.y / n, q.y),
+            lane_math::Select<W>(positive, q.z / n, q.z)};
   }
-  // RotationVectorToQuaternion (attitude.cc), per lane (it branches on the angle).
+  // RotationVectorToQuaternion (attitude.cc): both of its branches for every lane, then the one
+  // each lane's angle takes.
   static Q4 RotationVectorToQuaternion(const V3& rho) {
-    Q4 q;
-    for (int i = 0; i < W; ++i) {
-      const double rx = rho.x[i], ry = rho.y[i], rz = rho.z[i];
-      const double a2 = rx * rx + (ry * ry + rz * rz);
-      const double a = __builtin_sqrt(a2);
-      double w, k;
-      if (a < 1e-4) {
-        w = 1.0 - a2 / 8.0 + a2 * a2 / 384.0;
-        k = 0.5 - a2 / 48.0 + a2 * a2 / 3840.0;
-      } else {
-        double sin_half, cos_half;
-        SinCos(0.5 * a, &sin_half, &cos_half);
-        w = cos_half;
-        k = sin_half / a;
-      }
-      q.w[i] = w;
-      q.x[i] = k * rx;
-      q.y[i] = k * ry;
-      q.z[i] = k * rz;
-    }
-    return q;
+    const P a2 = rho.x * rho.x + (rho.y * rho.y + rho.z * rho.z);
+    const P a = Sqrt(a2);
+    const U small = Mask(a < 1e-4);
+    P sin_half, cos_half;
+    lane_math::SinCos<W>(0.5 * a, sin_half, cos_half);
+    const P w = lane_math::Select<W>(small, 1.0 - a2 / 8.0 + a2 * a2 / 384.0, cos_half);
+    const P k = lane_math::Select<W>(small, 0.5 - a2 / 48.0 + a2 * a2 / 3840.0, sin_half / a);
+    return {w, k * rho.x, k * rho.y, k * rho.z};
   }
 
   // ---- Earth (earth.cc) ------------------------------------------------------------------------
@@ -179,12 +133,7 @@ struct Kernel {
   };
   static Lat LatOf(P L) {
     Lat l{L, L, L};
-    for (int i = 0; i < W; ++i) {
-      double sin_L, cos_L;
-      SinCos(L[i], &sin_L, &cos_L);
-      l.s[i] = sin_L;
-      l.c[i] = cos_L;
-    }
+    lane_math::SinCos<W>(L, l.s, l.c);
     return l;
   }
   static P MeridianRadius(const Lat& l) {
@@ -205,7 +154,7 @@ struct Kernel {
     if (e.flat) return Splat3(0.0, 0.0, 0.0);
     const P R_E = TransverseRadius(l) + h;
     const P R_N = MeridianRadius(l) + h;
-    return {v.y / R_E, -v.x / R_N, -v.y * Tan(l.L) / R_E};
+    return {v.y / R_E, -v.x / R_N, -v.y * (l.s / l.c) / R_E};
   }
   static V3 Gravity(const EarthParams& e, const Lat& l, P h) {
     if (e.flat) return Splat3(0.0, 0.0, e.flat_gravity_m_per_s2);

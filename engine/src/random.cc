@@ -1,6 +1,7 @@
 // Philox4x32-10 and the Box-Muller transform with the engine's own ln, sin, cos (random.h).
 #include "driftlab/random.h"
 
+#include "lane_math.h"
 #include "random_kernels.h"
 
 namespace driftlab {
@@ -48,6 +49,10 @@ double PolyLog(double x) { return LogInline(x); }
 
 void PolySinCosTwoPi(uint32_t x, double* sin_out, double* cos_out) {
   SinCosTwoPiInline(x, *sin_out, *cos_out);
+}
+
+void PolySinCos(double x, double* sin_out, double* cos_out) {
+  lane_math::SinCos<1>(x, *sin_out, *cos_out);
 }
 
 }  // namespace driftlab

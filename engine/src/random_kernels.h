@@ -9,6 +9,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "lane_math.h"
+
 namespace driftlab::random_kernels {
 namespace {
 
@@ -51,85 +53,10 @@ inline void Philox10(uint32_t& c0, uint32_t& c1, uint32_t& c2, uint32_t& c3, uin
   }
 }
 
-// ln 2 split so that e * kLn2Hi is exact for |e| < 2^11 (the fdlibm split: kLn2Hi has 32
-// significant bits). ln 2 = 0.693147180559945309417232121458...
-constexpr double kLn2Hi = 6.93147180369123816490e-01;
-constexpr double kLn2Lo = 1.90821492927058770002e-10;
-constexpr double kSqrt2 = 1.41421356237309504880;
-constexpr double kHalfPi = 1.57079632679489661923;
+inline double LogInline(double x) { return lane_math::Log<1>(x); }
 
-inline double LogInline(double x) {
-  // x = 2^e m, m in [sqrt(1/2), sqrt(2)); ln x = e ln 2 + 2 atanh(s), s = (m - 1)/(m + 1),
-  // atanh(s) = s + s^3/3 + s^5/5 + ...  (|s| <= 3 - 2 sqrt 2 = 0.1716, s^2 <= 0.02944; the first
-  // omitted term 2 s^23 / 23 < 1e-18 relative to ln m).
-  // Branch-free and with 64-bit integer operations only (shift, and, or), so that the loops
-  // calling it vectorise: the exponent field becomes a double by the 2^52 magic-number trick.
-  const uint64_t bits = __builtin_bit_cast(uint64_t, x);
-  const double biased_exponent =
-      __builtin_bit_cast(double, 0x4330000000000000ull | (bits >> 52)) - 4503599627370496.0;
-  const double m_raw =
-      __builtin_bit_cast(double, (bits & 0x000fffffffffffffull) | 0x3ff0000000000000ull);  // [1, 2)
-  const bool big = m_raw > kSqrt2;
-  const double m = big ? 0.5 * m_raw : m_raw;
-  const double ed = biased_exponent - (big ? 1022.0 : 1023.0);
-  const double s = (m - 1.0) / (m + 1.0);
-  const double s2 = s * s;
-  double p = 1.0 / 21.0;
-  p = p * s2 + 1.0 / 19.0;
-  p = p * s2 + 1.0 / 17.0;
-  p = p * s2 + 1.0 / 15.0;
-  p = p * s2 + 1.0 / 13.0;
-  p = p * s2 + 1.0 / 11.0;
-  p = p * s2 + 1.0 / 9.0;
-  p = p * s2 + 1.0 / 7.0;
-  p = p * s2 + 1.0 / 5.0;
-  p = p * s2 + 1.0 / 3.0;
-  const double log_m = 2.0 * s + 2.0 * s * s2 * p;
-  return ed * kLn2Hi + (ed * kLn2Lo + log_m);
-}
-
-// n! for the Taylor coefficients 1/n!; exact in double for n <= 18 (18! < 2^53), so 1.0 / n! is
-// correctly rounded at compile time.
-constexpr double Factorial(int n) { return n <= 1 ? 1.0 : n * Factorial(n - 1); }
-
-// sin and cos of 2 pi x / 2^32. Quadrant and remainder come exactly from the integer:
-// n = round(x / 2^30), q = n mod 4 = ((x + 2^29) mod 2^32) >> 30, and
-// r 2^30 = x - n 2^30 in [-2^29, 2^29) (wrapping 32-bit arithmetic), theta = r pi/2 in
-// [-pi/4, pi/4]. Only 32/64-bit integer and double operations, no branches: vectorises.
 inline void SinCosTwoPiInline(uint32_t x, double& sin_out, double& cos_out) {
-  const uint32_t q = (x + 0x20000000u) >> 30;
-  const int32_t r = static_cast<int32_t>(x - (q << 30));
-  const double t = static_cast<double>(r) * (kHalfPi / 1073741824.0);
-  const double t2 = t * t;
-  // sin t = t - t^3/3! + ... + t^17/17!  (omitted t^19/19! < 1e-19 at |t| = pi/4)
-  double ps = 1.0 / Factorial(17);
-  ps = -ps * t2 + 1.0 / Factorial(15);
-  ps = -ps * t2 + 1.0 / Factorial(13);
-  ps = -ps * t2 + 1.0 / Factorial(11);
-  ps = -ps * t2 + 1.0 / Factorial(9);
-  ps = -ps * t2 + 1.0 / Factorial(7);
-  ps = -ps * t2 + 1.0 / Factorial(5);
-  ps = -ps * t2 + 1.0 / Factorial(3);
-  const double s = t - t * t2 * ps;
-  // cos t = 1 - t^2/2! + ... + t^16/16!  (omitted t^18/18! < 2e-18)
-  double pc = 1.0 / Factorial(16);
-  pc = -pc * t2 + 1.0 / Factorial(14);
-  pc = -pc * t2 + 1.0 / Factorial(12);
-  pc = -pc * t2 + 1.0 / Factorial(10);
-  pc = -pc * t2 + 1.0 / Factorial(8);
-  pc = -pc * t2 + 1.0 / Factorial(6);
-  pc = -pc * t2 + 1.0 / Factorial(4);
-  pc = -pc * t2 + 1.0 / Factorial(2);
-  const double c = 1.0 - t2 * pc;
-  // Rotate by the quadrant: (sin, cos) -> (c, -s), (-s, -c), (-c, s) for q = 1, 2, 3; the signs
-  // are applied by flipping the sign bit.
-  const bool odd = (q & 1u) != 0;
-  const double sw = odd ? c : s;
-  const double cw = odd ? s : c;
-  const uint64_t sin_sign = static_cast<uint64_t>(q & 2u) << 62;
-  const uint64_t cos_sign = static_cast<uint64_t>((q + 1u) & 2u) << 62;
-  sin_out = __builtin_bit_cast(double, __builtin_bit_cast(uint64_t, sw) ^ sin_sign);
-  cos_out = __builtin_bit_cast(double, __builtin_bit_cast(uint64_t, cw) ^ cos_sign);
+  lane_math::SinCosTwoPi<1>(x, sin_out, cos_out);
 }
 
 // Deviates of blocks [block0, block0 + nblocks) in index order (4 per block) into out.
@@ -155,15 +82,17 @@ inline void GaussianChunk(const uint32_t* key, uint32_t run_word, uint32_t strea
                           uint64_t block0, int nblocks, double* out) {
   uint32_t x[4][kChunkBlocks];
   PhiloxChunk(key, run_word, stream_word, block0, nblocks, x);
-  // Box-Muller on the pairs (x0, x1) -> deviates 0, 1 and (x2, x3) -> deviates 2, 3 of a block.
+  // Box-Muller on the pairs (x0, x1) -> deviates 0, 1 and (x2, x3) -> deviates 2, 3 of a block:
+  // z = sqrt(-2 ln u1) (cos, sin)(2 pi u2), u1 = (x0 + 1) 2^-32 in (0, 1], u2 = x1 2^-32.
+  // Branch-free scalar code (lane_math.h, W = 1) that the compiler vectorises across blocks.
   for (int pair = 0; pair < 2; ++pair) {
     const uint32_t* xr = x[2 * pair];
     const uint32_t* xa = x[2 * pair + 1];
     for (int b = 0; b < nblocks; ++b) {
-      const double u1 = (static_cast<double>(xr[b]) + 1.0) * kTwoPowMinus32;  // (0, 1]
-      const double radius = __builtin_sqrt(-2.0 * LogInline(u1));
+      const double u1 = (lane_math::ToDouble<1>(xr[b]) + 1.0) * kTwoPowMinus32;
+      const double radius = __builtin_sqrt(-2.0 * lane_math::Log<1>(u1));
       double s, c;
-      SinCosTwoPiInline(xa[b], s, c);  // angle 2 pi u2, u2 = x 2^-32 in [0, 1)
+      lane_math::SinCosTwoPi<1>(xa[b], s, c);
       out[4 * b + 2 * pair] = radius * c;
       out[4 * b + 2 * pair + 1] = radius * s;
     }

@@ -116,5 +116,9 @@ double PolyLog(double x);
 // a quadrant and theta in [-pi/4, pi/4], Taylor series to theta^17 (sin) and theta^16 (cos)
 // (truncation < 1e-19), then rotated by the quadrant.
 void PolySinCosTwoPi(uint32_t x, double* sin_out, double* cos_out);
+// sin x and cos x as the navigation code computes them (earth.cc, attitude.cc and the lockstep
+// kernels, engine/src/lane_math.h): n = round(2x/pi), t = x - n pi/2 by Cody-Waite with pi/2 in
+// three 33-bit pieces (exact for |x| < 1.6e6 rad), the same Taylor series on t, rotated by n mod 4.
+void PolySinCos(double x, double* sin_out, double* cos_out);
 
 }  // namespace driftlab
