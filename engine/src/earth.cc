@@ -9,48 +9,51 @@ namespace driftlab {
 namespace {
 
 // The engine's own sin and cos (lane_math.h): the lockstep kernels compute the same bits.
-double Sin(double x) {
+struct SinCosOf {
   double s, c;
-  lane_math::SinCos<1>(x, s, c);
-  return s;
-}
-double Cos(double x) {
-  double s, c;
-  lane_math::SinCos<1>(x, s, c);
-  return c;
-}
+  explicit SinCosOf(double x) { lane_math::SinCos<1>(x, s, c); }
+};
+double Sin(double x) { return SinCosOf(x).s; }
+double Cos(double x) { return SinCosOf(x).c; }
 
-}  // namespace
-
-double MeridianRadius(double L_b) {
-  const double s = Sin(L_b);
+// The formulas below take sin L, computed once per call of the public functions (each public
+// function used to evaluate sin L once per radius; the operations on it are unchanged).
+double MeridianRadiusOfSin(double s) {
   const double d = 1.0 - kWgs84Eccentricity2 * s * s;
   return kWgs84SemiMajorAxis_m * (1.0 - kWgs84Eccentricity2) / (d * std::sqrt(d));
 }
 
-double TransverseRadius(double L_b) {
-  const double s = Sin(L_b);
+double TransverseRadiusOfSin(double s) {
   return kWgs84SemiMajorAxis_m / std::sqrt(1.0 - kWgs84Eccentricity2 * s * s);
 }
 
-double SomiglianaGravity(double L_b) {
+double SomiglianaGravityOfSin(double s) {
   // k = b gamma_p / (a gamma_e) - 1, Groves (2.134) / NIMA TR8350.2 (4-1).
   const double k = kWgs84SemiMinorAxis_m * kWgs84GammaPole_m_per_s2 /
                        (kWgs84SemiMajorAxis_m * kWgs84GammaEquator_m_per_s2) -
                    1.0;
-  const double s2 = Sin(L_b) * Sin(L_b);
+  const double s2 = s * s;
   return kWgs84GammaEquator_m_per_s2 * (1.0 + k * s2) / std::sqrt(1.0 - kWgs84Eccentricity2 * s2);
 }
+
+}  // namespace
+
+double MeridianRadius(double L_b) { return MeridianRadiusOfSin(Sin(L_b)); }
+
+double TransverseRadius(double L_b) { return TransverseRadiusOfSin(Sin(L_b)); }
+
+double SomiglianaGravity(double L_b) { return SomiglianaGravityOfSin(Sin(L_b)); }
 
 Vector3d GravityNed(double L_b, double h_b) {
   const double a = kWgs84SemiMajorAxis_m;
   const double f = kWgs84Flattening;
-  const double s2 = Sin(L_b) * Sin(L_b);
+  const double s = Sin(L_b);
+  const double s2 = s * s;
   // m = omega_ie^2 a^2 b / mu, the ratio of centrifugal to gravitational acceleration at the
   // equator (NIMA TR8350.2 table 3.3: 0.00344978650684).
   const double m = kWgs84EarthRate_rad_per_s * kWgs84EarthRate_rad_per_s * a * a *
                    kWgs84SemiMinorAxis_m / kWgs84GM_m3_per_s2;
-  const double g0 = SomiglianaGravity(L_b);
+  const double g0 = SomiglianaGravityOfSin(s);
   const double g_D =
       g0 * (1.0 - 2.0 / a * (1.0 + f * (1.0 - 2.0 * s2) + m) * h_b + 3.0 * h_b * h_b / (a * a));
   const double g_N = -8.08e-9 * h_b * Sin(2.0 * L_b);
@@ -58,14 +61,15 @@ Vector3d GravityNed(double L_b, double h_b) {
 }
 
 Vector3d EarthRateNed(double L_b) {
-  return Vector3d(kWgs84EarthRate_rad_per_s * Cos(L_b), 0.0,
-                  -kWgs84EarthRate_rad_per_s * Sin(L_b));
+  const SinCosOf L(L_b);
+  return Vector3d(kWgs84EarthRate_rad_per_s * L.c, 0.0, -kWgs84EarthRate_rad_per_s * L.s);
 }
 
 Vector3d TransportRateNed(double L_b, double h_b, const Vector3d& v_eb_n) {
-  const double R_E = TransverseRadius(L_b) + h_b;
-  const double R_N = MeridianRadius(L_b) + h_b;
-  return Vector3d(v_eb_n.y() / R_E, -v_eb_n.x() / R_N, -v_eb_n.y() * (Sin(L_b) / Cos(L_b)) / R_E);
+  const SinCosOf L(L_b);
+  const double R_E = TransverseRadiusOfSin(L.s) + h_b;
+  const double R_N = MeridianRadiusOfSin(L.s) + h_b;
+  return Vector3d(v_eb_n.y() / R_E, -v_eb_n.x() / R_N, -v_eb_n.y() * (L.s / L.c) / R_E);
 }
 
 Vector3d LlhToEcef(const Llh& llh) {
@@ -171,8 +175,9 @@ Vector3d NavEnvironment::LlhRate(double L_b, double h_b, const Vector3d& v_eb_n)
     // Flat frame: h plays no part in the metre scaling and there is no convergence of meridians.
     return Vector3d(v_eb_n.x() / flat_R_N_m_, v_eb_n.y() / flat_R_E_m_, -v_eb_n.z());
   }
-  return Vector3d(v_eb_n.x() / (MeridianRadius(L_b) + h_b),
-                  v_eb_n.y() / ((TransverseRadius(L_b) + h_b) * Cos(L_b)), -v_eb_n.z());
+  const SinCosOf L(L_b);
+  return Vector3d(v_eb_n.x() / (MeridianRadiusOfSin(L.s) + h_b),
+                  v_eb_n.y() / ((TransverseRadiusOfSin(L.s) + h_b) * L.c), -v_eb_n.z());
 }
 
 Vector3d NavEnvironment::PositionErrorNed(const Llh& estimate, const Llh& truth) const {

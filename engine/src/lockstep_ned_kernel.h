@@ -126,21 +126,25 @@ struct Kernel {
   static constexpr double kGammaE = 9.7803253359;
   static constexpr double kGammaP = 9.8321849378;
 
-  // sin L computed once per latitude and reused: the scalar code calls sin(L) several times on
-  // the same argument, each giving the same bits.
+  // Per latitude, computed once and reused: sin L, cos L, and the two radii of curvature. The
+  // scalar code (earth.cc) evaluates d = 1 - e^2 sin^2 L and sqrt(d) again in MeridianRadius and
+  // TransverseRadius on every call, each time with the same operations on the same argument, so
+  // the bits are the same.
   struct Lat {
     P L, s, c;
+    P R_N0, R_E0;  // MeridianRadius(L), TransverseRadius(L)
   };
   static Lat LatOf(P L) {
-    Lat l{L, L, L};
+    Lat l{L, L, L, L, L};
     lane_math::SinCos<W>(L, l.s, l.c);
+    const P d = 1.0 - kE2 * l.s * l.s;
+    const P sqrt_d = Sqrt(d);
+    l.R_N0 = kA * (1.0 - kE2) / (d * sqrt_d);
+    l.R_E0 = kA / sqrt_d;
     return l;
   }
-  static P MeridianRadius(const Lat& l) {
-    const P d = 1.0 - kE2 * l.s * l.s;
-    return kA * (1.0 - kE2) / (d * Sqrt(d));
-  }
-  static P TransverseRadius(const Lat& l) { return kA / Sqrt(1.0 - kE2 * l.s * l.s); }
+  static P MeridianRadius(const Lat& l) { return l.R_N0; }
+  static P TransverseRadius(const Lat& l) { return l.R_E0; }
 
   static V3 LlhRate(const EarthParams& e, const Lat& l, P h, const V3& v) {
     if (e.flat) return {v.x / e.flat_R_N_m, v.y / e.flat_R_E_m, -v.z};
