@@ -11,6 +11,10 @@
 
 #include "lane_math.h"
 
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
 namespace driftlab::random_kernels {
 namespace {
 
@@ -62,9 +66,84 @@ inline void SinCosTwoPiInline(uint32_t x, double& sin_out, double& cos_out) {
 // Deviates of blocks [block0, block0 + nblocks) in index order (4 per block) into out.
 constexpr int kChunkBlocks = 32;
 
+// Philox blocks per explicit vector (64-bit lanes) where that beats the compiler's own
+// vectorisation of the scalar loop: AVX2 (0.91 against 1.75 ns per 32-bit word measured, GCC 12
+// -O2, which leaves that loop scalar); GCC vectorises it for AVX-512 itself (0.63 ns, better than
+// the explicit form's 0.81), and SSE2's two lanes gain nothing.
+#if defined(__AVX2__) && !defined(__AVX512F__)
+constexpr int kPhiloxLanes = 4;
+#else
+constexpr int kPhiloxLanes = 1;
+#endif
+
+// a * m for lanes a < 2^32: the 32 x 32 -> 64-bit product Philox needs, by the instruction that
+// multiplies the low 32 bits of each 64-bit lane (VPMULUDQ). Integer arithmetic: exact, the
+// same on every path.
+template <int W>
+inline lane_math::U<W> MulLow32(lane_math::U<W> a, uint32_t m) {
+#if defined(__AVX2__)
+  if constexpr (W == 4) {
+    return reinterpret_cast<lane_math::U<W>>(
+        _mm256_mul_epu32(reinterpret_cast<__m256i>(a), _mm256_set1_epi64x(m)));
+  }
+#endif
+  return a * static_cast<uint64_t>(m);
+}
+
+// Philox4x32-10 of the counters (block, run_word, stream_word) for W consecutive blocks, in
+// 64-bit lanes holding 32-bit words; the rounds of Philox10 above.
+template <int W>
+inline void PhiloxLanes(const uint32_t* key, uint32_t run_word, uint32_t stream_word,
+                        uint64_t block, uint32_t (&x)[4][kChunkBlocks], int b) {
+  using lane_math::U;
+  U<W> blocks;
+  if constexpr (W == 1) {
+    blocks = block;
+  } else {
+    for (int i = 0; i < W; ++i) blocks[i] = block + static_cast<uint64_t>(i);
+  }
+  U<W> c0 = blocks & 0xffffffffu;
+  U<W> c1 = blocks >> 32;
+  U<W> c2 = U<W>{} + run_word;
+  U<W> c3 = U<W>{} + stream_word;
+  uint32_t k0 = key[0], k1 = key[1];
+  for (int round = 0; round < 10; ++round) {  // kPhiloxRounds (random.h)
+    if (round > 0) {
+      k0 += kPhiloxW0;
+      k1 += kPhiloxW1;
+    }
+    const U<W> p0 = MulLow32<W>(c0, kPhiloxM0);
+    const U<W> p1 = MulLow32<W>(c2, kPhiloxM1);
+    c0 = (p1 >> 32) ^ c1 ^ static_cast<uint64_t>(k0);
+    c1 = p1 & 0xffffffffu;
+    c2 = (p0 >> 32) ^ c3 ^ static_cast<uint64_t>(k1);
+    c3 = p0 & 0xffffffffu;
+  }
+  if constexpr (W == 1) {
+    x[0][b] = static_cast<uint32_t>(c0);
+    x[1][b] = static_cast<uint32_t>(c1);
+    x[2][b] = static_cast<uint32_t>(c2);
+    x[3][b] = static_cast<uint32_t>(c3);
+  } else {
+    for (int i = 0; i < W; ++i) {
+      x[0][b + i] = static_cast<uint32_t>(c0[i]);
+      x[1][b + i] = static_cast<uint32_t>(c1[i]);
+      x[2][b + i] = static_cast<uint32_t>(c2[i]);
+      x[3][b + i] = static_cast<uint32_t>(c3[i]);
+    }
+  }
+}
+
 inline void PhiloxChunk(const uint32_t* key, uint32_t run_word, uint32_t stream_word,
                         uint64_t block0, int nblocks, uint32_t (&x)[4][kChunkBlocks]) {
-  for (int b = 0; b < nblocks; ++b) {
+  int b = 0;
+  if constexpr (kPhiloxLanes > 1) {
+    for (; b + kPhiloxLanes <= nblocks; b += kPhiloxLanes) {
+      PhiloxLanes<kPhiloxLanes>(key, run_word, stream_word, block0 + static_cast<uint64_t>(b), x,
+                                b);
+    }
+  }
+  for (; b < nblocks; ++b) {
     const uint64_t block = block0 + static_cast<uint64_t>(b);
     uint32_t c0 = static_cast<uint32_t>(block);
     uint32_t c1 = static_cast<uint32_t>(block >> 32);
