@@ -115,9 +115,30 @@ void BM_NedWhiteGaussMarkovRandomWalk(benchmark::State& state) {
 }
 void BM_NedTactical(benchmark::State& state) { Run(state, FindImuPreset("tactical")); }
 
+// Thread scaling (strong: the same job on 1 and 2 threads, wall time): white + Gauss-Markov +
+// random walk, 256 runs, the widest path the CPU has. The shared truth (~50 ms here, one thread)
+// is the serial part: its share of the one-thread time bounds the speed-up (Amdahl).
+void BM_NedThreads(benchmark::State& state) {
+  MonteCarloSpec spec = BenchJob(WhiteGaussMarkovRandomWalk());
+  spec.runs = 256;
+  spec.threads = static_cast<int>(state.range(0));
+  int64_t samples = 0;
+  double truth_s = 0.0, wall_s = 0.0;
+  for (auto _ : state) {
+    const MonteCarloStatistics stats = RunMonteCarlo(spec);
+    samples += stats.data().timings.samples_processed;
+    truth_s += stats.data().timings.truth_s;
+    wall_s += stats.data().timings.wall_s;
+    benchmark::DoNotOptimize(stats.data().epochs.data());
+  }
+  state.SetItemsProcessed(samples);
+  state.counters["truth_fraction"] = truth_s / wall_s;
+}
+
 BENCHMARK(BM_NedWhiteOnly)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_NedWhiteGaussMarkovRandomWalk)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_NedTactical)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_NedThreads)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace driftlab

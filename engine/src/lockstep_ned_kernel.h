@@ -109,8 +109,12 @@ struct Kernel {
     const P a2 = rho.x * rho.x + (rho.y * rho.y + rho.z * rho.z);
     const P a = Sqrt(a2);
     const U small = Mask(a < 1e-4);
-    P sin_half, cos_half;
-    lane_math::SinCos<W>(0.5 * a, sin_half, cos_half);
+    // The Earth-rate rotation (~1e-6 rad a step) and a slowly turning body take the series in
+    // every lane: sin and cos are then skipped (their lanes would not be selected).
+    bool any_large = false;
+    for (int i = 0; i < W; ++i) any_large = any_large || small[i] == 0;
+    P sin_half = Splat(0.0), cos_half = Splat(1.0);
+    if (any_large) lane_math::SinCos<W>(0.5 * a, sin_half, cos_half);
     const P w = lane_math::Select<W>(small, 1.0 - a2 / 8.0 + a2 * a2 / 384.0, cos_half);
     const P k = lane_math::Select<W>(small, 0.5 - a2 / 48.0 + a2 * a2 / 3840.0, sin_half / a);
     return {w, k * rho.x, k * rho.y, k * rho.z};
