@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "driftlab/spec_error.h"
 
@@ -30,6 +31,7 @@ void ErrorCovariancePropagator::Propagate(const NavState& reference, const Vecto
                                           double dt_s, const Vector3d& omega_ib_b) {
   const ErrorStateMatrix F = ErrorStateSystemMatrix(env_, reference, f_ib_b, noise_, omega_ib_b);
   if (method_ == Discretization::kVanLoan) {
+    if (PropagateExactSeries(F, dt_s)) return;
     ErrorStateMatrix Phi, Q_d;
     DiscretizeErrorModel(F, Q_c_, dt_s, method_, &Phi, &Q_d);
     P_ = (Phi * P_ * Phi.transpose()).eval() + Q_d;
@@ -47,8 +49,23 @@ void ErrorCovariancePropagator::Propagate(const NavState& reference, const Vecto
   B_ = F_ns * dt_s + 0.5 * dt_s * dt_s * (F_nn * F_ns + F_ns * D.asDiagonal());
   d_ = (Eigen::VectorXd::Ones(m) + D * dt_s + 0.5 * (D * dt_s).cwiseAbs2());
   const Eigen::Matrix<double, n, 1> q_n = Q_c_.diagonal().head(n);
+  // Q_d = dt / 2 (Phi Q_c Phi^T + Q_c), Q_c = diag(q_n, q_s).
+  const Eigen::MatrixXd BQ = B_ * q_s_.asDiagonal();  // n x m
+  const Eigen::MatrixXd Qd_nn =
+      0.5 * dt_s *
+      (A_ * q_n.asDiagonal() * A_.transpose() + BQ * B_.transpose() +
+       Eigen::Matrix<double, n, n>(q_n.asDiagonal()));
+  const Eigen::MatrixXd Qd_ns = 0.5 * dt_s * BQ * d_.asDiagonal();
+  const Eigen::VectorXd Qd_ss = 0.5 * dt_s * (d_.cwiseAbs2().cwiseProduct(q_s_) + q_s_);
+  ApplyStructuredStep(Qd_nn, Qd_ns, Qd_ss);
+}
 
-  // P <- Phi P Phi^T with P = [[P_nn, P_ns], [P_ns^T, P_ss]].
+void ErrorCovariancePropagator::ApplyStructuredStep(const Eigen::MatrixXd& Qd_nn,
+                                                    const Eigen::MatrixXd& Qd_ns,
+                                                    const Eigen::VectorXd& Qd_ss) {
+  // P <- Phi P Phi^T + Q_d with Phi = [[A, B], [0, diag(d)]] and P = [[P_nn, P_ns], [P_ns^T, P_ss]].
+  constexpr int n = kNumNavErrorStates;
+  const int m = layout_.size - n;
   const auto P_nn = P_.topLeftCorner(n, n);
   const auto P_ns = P_.topRightCorner(n, m);
   const auto P_ss = P_.bottomRightCorner(m, m);
@@ -56,15 +73,6 @@ void ErrorCovariancePropagator::Propagate(const NavState& reference, const Vecto
   Pns_ = A_ * P_ns + BPss_;  // (Phi P)_ns before the diag(d) on the right
   Pnn_ = A_ * P_nn * A_.transpose() + A_ * P_ns * B_.transpose() +
          (A_ * P_ns * B_.transpose()).transpose() + BPss_ * B_.transpose();
-  // Q_d = dt / 2 (Phi Q_c Phi^T + Q_c), Q_c = diag(q_n, q_s).
-  const Eigen::MatrixXd BQ = B_ * q_s_.asDiagonal();  // n x m
-  const Eigen::Matrix<double, n, n> Qd_nn =
-      0.5 * dt_s *
-      (A_ * q_n.asDiagonal() * A_.transpose() + BQ * B_.transpose() +
-       Eigen::Matrix<double, n, n>(q_n.asDiagonal()));
-  const Eigen::MatrixXd Qd_ns = 0.5 * dt_s * BQ * d_.asDiagonal();
-  const Eigen::VectorXd Qd_ss = 0.5 * dt_s * (d_.cwiseAbs2().cwiseProduct(q_s_) + q_s_);
-
   P_.topLeftCorner(n, n) = Pnn_ + Qd_nn;
   P_.topRightCorner(n, m) = Pns_ * d_.asDiagonal();
   P_.topRightCorner(n, m) += Qd_ns;
@@ -73,6 +81,84 @@ void ErrorCovariancePropagator::Propagate(const NavState& reference, const Vecto
   P_.bottomLeftCorner(m, n) = P_.topRightCorner(n, m).transpose();
   P_.topLeftCorner(n, n) =
       0.5 * (P_.topLeftCorner(n, n) + P_.topLeftCorner(n, n).transpose()).eval();
+}
+
+bool ErrorCovariancePropagator::PropagateExactSeries(const ErrorStateMatrix& F, double h) {
+  // Van Loan's exact Phi = exp(F h) and Q_d = int_0^h Phi(s) Q_c Phi(s)^T ds for the structured
+  // model F = [[F_nn, F_ns], [0, D]] (header), by the power series instead of the exponential of
+  // the 2N x 2N matrix: with T_k = (F h)^k / k! = [[N_k, U_k], [0, diag(E_k)]],
+  //   N_k = (F_nn h) N_(k-1) / k,  E_k = (D h)^k / k!,
+  //   U_k = ((F_nn h) U_(k-1) + (F_ns h) diag(E_(k-1))) / k,  U_0 = 0,
+  // Phi = sum_k T_k (Phi_ss = exp(D h) exactly), and, since Phi(s) = sum_k T_k (s/h)^k,
+  //   Q_d = h sum_(i,j) T_i Q_c T_j^T / (i + j + 1),
+  // whose sensor block is diag(q_s (exp(2 D h) - 1) / (2 D)) in closed form. The series is summed
+  // until a term adds less than 1e-17 of the sum (at most 40 terms); for ||F_nn h||_1 > 2 or
+  // |D h| > 2 (long steps) the dense exponential is used instead.
+  constexpr int n = kNumNavErrorStates;
+  const int m = layout_.size - n;
+  if (m <= 0 || !F.bottomLeftCorner(m, n).isZero(0.0)) return false;
+  const Eigen::VectorXd D = F.bottomRightCorner(m, m).diagonal();
+  for (int j = 0; j < m; ++j) {
+    for (int i = 0; i < m; ++i) {
+      if (i != j && F(n + i, n + j) != 0.0) return false;
+    }
+  }
+  const Eigen::Matrix<double, n, n> Ah = F.topLeftCorner(n, n) * h;
+  const Eigen::MatrixXd Bh = F.topRightCorner(n, m) * h;
+  const Eigen::VectorXd Dh = D * h;
+  if (Ah.cwiseAbs().colwise().sum().maxCoeff() > 2.0 || Dh.cwiseAbs().maxCoeff() > 2.0) {
+    return false;
+  }
+  constexpr int kMaxTerms = 40;
+  std::vector<Eigen::Matrix<double, n, n>> N{Eigen::Matrix<double, n, n>::Identity()};
+  std::vector<Eigen::MatrixXd> U{Eigen::MatrixXd::Zero(n, m)};
+  std::vector<Eigen::VectorXd> E{Eigen::VectorXd::Ones(m)};
+  A_ = N[0];
+  B_ = U[0];
+  for (int k = 1; k < kMaxTerms; ++k) {
+    N.push_back(Ah * N[k - 1] / k);
+    U.push_back((Ah * U[k - 1] + Bh * E[k - 1].asDiagonal()) / k);
+    E.push_back(E[k - 1].cwiseProduct(Dh) / k);
+    A_ += N[k];
+    B_ += U[k];
+    const double added = N[k].cwiseAbs().maxCoeff() + U[k].cwiseAbs().maxCoeff() +
+                         E[k].cwiseAbs().maxCoeff();
+    const double total = A_.cwiseAbs().maxCoeff() + B_.cwiseAbs().maxCoeff() + 1.0;
+    if (added < 1e-17 * total) break;
+  }
+  const int K = static_cast<int>(N.size());
+  d_ = Dh.array().exp().matrix();
+  const Eigen::Matrix<double, n, 1> q_n = Q_c_.diagonal().head(n);
+  // Q_d blocks: nn = h sum_(i,j) (N_i Q_n N_j^T + U_i Q_s U_j^T) / (i + j + 1);
+  // ns = h sum_i U_i diag(q_s G_i), G_i = sum_j E_j / (i + j + 1) = int_0^1 s^i exp(D h s) ds.
+  Eigen::MatrixXd Qd_nn = Eigen::MatrixXd::Zero(n, n);
+  Eigen::MatrixXd Qd_ns = Eigen::MatrixXd::Zero(n, m);
+  for (int i = 0; i < K; ++i) {
+    Eigen::Matrix<double, n, n> N_sum = Eigen::Matrix<double, n, n>::Zero();
+    Eigen::MatrixXd U_sum = Eigen::MatrixXd::Zero(n, m);
+    Eigen::VectorXd G = Eigen::VectorXd::Zero(m);
+    for (int j = 0; j < K; ++j) {
+      const double w = 1.0 / (i + j + 1);
+      N_sum += w * N[j];
+      if (j > 0) U_sum += w * U[j];
+      G += w * E[j];
+    }
+    Qd_nn += N[i] * q_n.asDiagonal() * N_sum.transpose();
+    if (i > 0) {
+      Qd_nn += U[i] * q_s_.asDiagonal() * U_sum.transpose();
+      Qd_ns += U[i] * q_s_.cwiseProduct(G).asDiagonal();
+    }
+  }
+  Qd_nn = (h * Qd_nn).eval();
+  Qd_ns = (h * Qd_ns).eval();
+  Eigen::VectorXd Qd_ss(m);
+  for (int j = 0; j < m; ++j) {
+    // int_0^h exp(2 d s) ds = h expm1(2 d h) / (2 d h), -> h as d h -> 0.
+    const double x = 2.0 * Dh(j);
+    Qd_ss(j) = q_s_(j) * h * (x == 0.0 ? 1.0 : std::expm1(x) / x);
+  }
+  ApplyStructuredStep(Qd_nn, Qd_ns, Qd_ss);
+  return true;
 }
 
 CovarianceEpoch MakeCovarianceEpoch(double t_s, const ErrorStateMatrix& P,

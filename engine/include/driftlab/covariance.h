@@ -23,7 +23,10 @@ namespace driftlab {
 //   B = F_ns dt + (F_nn F_ns + F_ns D) dt^2 / 2 (the second-order terms of (F dt)^2 / 2),
 //   d = 1 + D dt + (D dt)^2 / 2,
 // the same Phi and trapezoidal Q_d as the dense second-order formula, in O(9 m^2) instead of
-// O((9 + m)^3) operations.
+// O((9 + m)^3) operations. With kVanLoan (exact Phi = exp(F dt) and Q_d) the same structure gives
+// the exact step from the power series of the blocks (covariance.cc), O(K^2 9 m) for K terms
+// (~10 at 0.1 s), instead of the exponential of a 2(9 + m)-square matrix; steps too long for the
+// series (||F_nn dt||_1 > 2 or |D dt| > 2) use that exponential.
 class ErrorCovariancePropagator {
  public:
   ErrorCovariancePropagator(const NavEnvironment& env, const ErrorStateNoise& noise,
@@ -46,6 +49,11 @@ class ErrorCovariancePropagator {
   ErrorStateMatrix Q_c_;
   Discretization method_;
   ErrorStateMatrix P_;
+  // The exact structured step; false when F lacks the structure or dt is too long for the series.
+  bool PropagateExactSeries(const ErrorStateMatrix& F, double dt_s);
+  // P <- Phi P Phi^T + Q_d from Phi = [[A_, B_], [0, diag(d_)]] and the blocks of Q_d.
+  void ApplyStructuredStep(const Eigen::MatrixXd& Qd_nn, const Eigen::MatrixXd& Qd_ns,
+                           const Eigen::VectorXd& Qd_ss);
   // Work space of the structured step (allocated once).
   Eigen::MatrixXd A_, B_, BPss_, Pnn_, Pns_;
   Eigen::VectorXd d_, q_s_;
