@@ -20,6 +20,7 @@
 
 #include "driftlab/error_state.h"
 #include "driftlab/monte_carlo.h"
+#include "run_loop.h"
 
 namespace driftlab::lockstep {
 struct Kernel;
@@ -29,8 +30,8 @@ namespace driftlab::mc_detail {
 
 using Clock = std::chrono::steady_clock;
 
-// Cancellation and progress are polled every kPollSamples samples of a run.
-constexpr int64_t kPollSamples = 1024;
+// Cancellation and progress are polled every kPollSamples samples of a run (run_loop.h).
+using run_loop::kPollSamples;
 
 inline double Seconds(Clock::time_point since) {
   return std::chrono::duration<double>(Clock::now() - since).count();
@@ -149,17 +150,18 @@ NavState NedStartState(const SharedTruth& s, const MonteCarloSpec& spec, uint32_
 // Gyrocompass or external heading: one decision per job (it depends on the model only).
 bool UseGyrocompass(const MonteCarloSpec& spec, const SharedTruth& truth);
 
-// ---- mc_runs.cc: one run each; false if stopped early, else *samples = the samples not yet
-// counted by Monitor::Poll.
+// ---- mc_runs.cc: one run each through run_loop::RunLoop, its reports into `sink`; false if
+// stopped early, else the run is counted as done in `monitor`.
 class Monitor;
 bool RunNed(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, bool gyrocompass,
-            const RunSink& sink, Monitor* monitor, int64_t* samples);
+            const RunSink& sink, Monitor* monitor);
 bool RunSeed000(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, const RunSink& sink,
-                Monitor* monitor, int64_t* samples);
+                Monitor* monitor);
+// With the NEES of the 9 navigation states at every epoch into `nees`.
 bool RunEkf(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, const RunSink& sink,
-            NeesAccumulator* nees, Monitor* monitor, int64_t* samples);
+            NeesAccumulator* nees, Monitor* monitor);
 bool RunComplementary(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run,
-                      const RunSink& sink, Monitor* monitor, int64_t* samples);
+                      const RunSink& sink, Monitor* monitor);
 
 // ---- mc_lockstep_runs.cc
 // All runs of a kNed job in lockstep groups of kernel.width runs, in parallel over groups.

@@ -1,15 +1,17 @@
-// ReplayMonteCarloRun: one run of a job sample by sample, as RunMonteCarlo computes it.
-#include <optional>
+// ReplayMonteCarloRun: one run of a job sample by sample through the engine's run loop
+// (run_loop.h), as RunMonteCarlo computes it.
+#include <type_traits>
+#include <utility>
 
 #include "driftlab/sensors.h"
 #include "driftlab/spec_error.h"
 #include "mc_internal.h"
+#include "run_loop.h"
 
 namespace driftlab {
 
 using mc_detail::BuildSharedTruth;
 using mc_detail::FilterName;
-using mc_detail::kPollSamples;
 using mc_detail::NedStartState;
 using mc_detail::Report;
 using mc_detail::SharedTruth;
@@ -33,8 +35,6 @@ bool ReplayMonteCarloRun(const MonteCarloSpec& spec_in, uint32_t run, bool navig
   const SharedTruth s = BuildSharedTruth(spec, /*keep_imu=*/false);
   const bool seed000 = spec.simulation.mechanization == MechanizationKind::kSeed000;
   const bool gyrocompass = UseGyrocompass(spec, s);
-  const bool truth_height =
-      !seed000 && spec.simulation.ned.vertical == VerticalChannel::kTruthHeight;
 
   MonteCarloRunLayout layout;
   layout.env = &s.env;
@@ -48,31 +48,24 @@ bool ReplayMonteCarloRun(const MonteCarloSpec& spec_in, uint32_t run, bool navig
   }
   if (on_start) on_start(layout);
 
-  // Two simulators of the run, as RunSimulation: increments (what mechanization A and
-  // RunMonteCarlo's kNed runs use) and point samples (mechanization B).
-  std::optional<ImuErrorSimulator> increment_errors, sample_errors;
-  if (spec.sensor) {
-    increment_errors.emplace(*spec.sensor, spec.seed, run, s.rate_hz);
-    sample_errors.emplace(*spec.sensor, spec.seed, run, s.rate_hz);
-  }
+  // Both measured streams of the run, as RunSimulation makes them: the increments (what
+  // mechanization A and RunMonteCarlo's kNed runs use) and the point samples (mechanization B).
   TrajectoryGenerator generator(spec.simulation.motion, spec.simulation.rate_hz);
-  const NavState truth0 = generator.initial_state();
-  ImuIncrement measured_increment;  // zero at k = 0
-  ImuSample measured_sample = generator.initial_sample();
-  if (sample_errors) sample_errors->Apply(generator.initial_sample(), &measured_sample);
-
-  std::optional<NedMechanization> ned;
-  std::optional<Seed000Mechanization> mech;
-  Eigen::Vector3d sum_dtheta = Eigen::Vector3d::Zero(), sum_dv = Eigen::Vector3d::Zero();
+  run_loop::StreamedImu imu(&generator, spec.sensor ? &*spec.sensor : nullptr, spec.seed, run,
+                            s.rate_hz);
   NavState nav;
   size_t next_report = 0;
-  auto emit = [&](int64_t k, const NavState& truth) {
+  auto emit = [&](int64_t k, const auto& navigator) {
+    const NavState& truth = imu.ideal().truth;
     MonteCarloRunStep step;
     step.k = k;
     step.truth = &truth;
-    step.measured_increment = &measured_increment;
-    step.measured_sample = &measured_sample;
-    if (navigate && k >= s.start_step) step.nav = &nav;
+    step.measured_increment = &imu.measured_increment();
+    step.measured_sample = &imu.measured_sample();
+    if (navigate && k >= s.start_step) {
+      nav = navigator.Solution(truth);
+      step.nav = &nav;
+    }
     if (next_report < s.reports.size() && s.reports[next_report].k == k) {
       step.epoch = s.reports[next_report].epoch;
       step.checkpoint = s.reports[next_report].checkpoint;
@@ -81,53 +74,35 @@ bool ReplayMonteCarloRun(const MonteCarloSpec& spec_in, uint32_t run, bool navig
     }
     on_step(step);
   };
-
-  // k = 0: mechanization B takes its first sample; mechanization A starts here unless aligning.
-  if (navigate && seed000) {
-    mech.emplace(s.dt_s, spec.simulation.seed000);
-    mech->Update(measured_sample);
-    if (s.start_step == 0) nav = mech->ToNed(s.env, truth0);
-  } else if (navigate && s.start_step == 0) {
-    ned.emplace(s.env, NedStartState(s, spec, run, gyrocompass, sum_dtheta, sum_dv), s.dt_s,
-                spec.simulation.ned);
-    nav = ned->state();
+  auto stopped = [&](int64_t) {
+    return cancel != nullptr && cancel->load(std::memory_order_relaxed);
+  };
+  auto replay = [&](auto& navigator) {
+    using Input = typename std::decay_t<decltype(navigator)>::Input;
+    auto measure = [&](int64_t k) -> const Input& {
+      imu.Advance(k);
+      return imu.measured<Input>();
+    };
+    return run_loop::RunLoop(s.n, measure, navigator, emit, stopped);
+  };
+  if (!navigate) {
+    run_loop::NoNavigator none;
+    return replay(none);
   }
-  emit(0, truth0);
-
-  TrajectorySample sample;
-  while (generator.Next(&sample)) {
-    const int64_t k = generator.step();
-    if (increment_errors) {
-      increment_errors->Apply(sample.increment, &measured_increment);
-      sample_errors->Apply(sample.sample, &measured_sample);
-    } else {
-      measured_increment = sample.increment;
-      measured_sample = sample.sample;
-    }
-    if (navigate && seed000) {
-      mech->Update(measured_sample);
-      if (k >= s.start_step) nav = mech->ToNed(s.env, truth0);
-    } else if (navigate && k <= s.start_step) {
-      // Alignment window (k = 1..s0), then the start state at s0 (RunNed).
-      sum_dtheta += measured_increment.delta_theta_ib_b;
-      sum_dv += measured_increment.delta_v_ib_b;
-      if (k == s.start_step) {
-        ned.emplace(s.env, NedStartState(s, spec, run, gyrocompass, sum_dtheta, sum_dv), s.dt_s,
-                    spec.simulation.ned);
-        nav = ned->state();
-      }
-    } else if (navigate) {
-      ned->Update(measured_increment);
-      if (truth_height) ned->SetVertical(sample.truth.llh.h_m, sample.truth.v_eb_n.z());
-      nav = ned->state();
-    }
-    emit(k, sample.truth);
-    if ((k & (kPollSamples - 1)) == 0 && cancel != nullptr &&
-        cancel->load(std::memory_order_relaxed)) {
-      return false;
-    }
+  if (seed000) {
+    run_loop::Seed000Navigator mech(s.env, s.truth0, s.dt_s, spec.simulation.seed000);
+    return replay(mech);
   }
-  return true;
+  run_loop::NedNavigator ned(
+      s.env, s.dt_s, spec.simulation.ned, s.start_step,
+      [&](const Eigen::Vector3d& sum_dtheta, const Eigen::Vector3d& sum_dv) {
+        return NedStartState(s, spec, run, gyrocompass, sum_dtheta, sum_dv);
+      },
+      [&](int64_t) {
+        const NavState& truth = imu.ideal().truth;
+        return std::pair<double, double>(truth.llh.h_m, truth.v_eb_n.z());
+      });
+  return replay(ned);
 }
 
 }  // namespace driftlab

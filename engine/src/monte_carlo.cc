@@ -128,20 +128,18 @@ MonteCarloOutput RunMonteCarloWithAnalysis(
                           if (monitor.Stopped()) return;
                           sink.slot = slot;
                           const uint32_t run = spec.first_run + slot;
-                          int64_t samples = 0;
                           bool done = false;
                           if (seed000) {
-                            done = RunSeed000(truth, spec, run, sink, &monitor, &samples);
+                            done = RunSeed000(truth, spec, run, sink, &monitor);
                           } else if (ekf) {
                             done = RunEkf(truth, spec, run, sink, &nees_accumulators.local(),
-                                          &monitor, &samples);
+                                          &monitor);
                           } else if (complementary) {
-                            done = RunComplementary(truth, spec, run, sink, &monitor, &samples);
+                            done = RunComplementary(truth, spec, run, sink, &monitor);
                           } else {
-                            done = RunNed(truth, spec, run, gyrocompass, sink, &monitor, &samples);
+                            done = RunNed(truth, spec, run, gyrocompass, sink, &monitor);
                           }
                           if (!done) return;
-                          monitor.RunDone(samples);
                         }
                       });
   });
