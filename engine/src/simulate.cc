@@ -1,14 +1,16 @@
-// Single-run simulation loop: ideal IMU data from the trajectory generator, optionally through a
-// sensor error model, through mechanization A or B, errors against the truth at every step.
+// Single-run simulation: ideal IMU data from the trajectory generator, optionally through a sensor
+// error model, through mechanization A or B, errors against the truth at every step; the engine's
+// run loop (run_loop.h) with a report at every sample and no cancellation.
 #include "driftlab/simulate.h"
 
 #include <algorithm>
 #include <cmath>
-#include <optional>
 #include <string>
+#include <utility>
 
 #include "driftlab/sensors.h"
 #include "driftlab/spec_error.h"
+#include "run_loop.h"
 
 namespace driftlab {
 
@@ -35,96 +37,64 @@ SimulationSummary RunErrorFreeSimulation(
 SimulationSummary RunSimulation(const SimulationSpec& spec, const SensorRun* sensor,
                                 const std::function<void(const SimulationStep&)>& on_step) {
   TrajectoryGenerator generator(spec.motion, spec.rate_hz);  // validates motion and rate
-  // Two simulators of the same run: one for the increment stream (mechanization A) and one for
-  // the point-sample stream (mechanization B); each Apply advances its simulator by one output.
-  // Both draw the run's constants (turn-on bias, scale factor, misalignment) from the same
-  // streams, so those are identical; the processes are each a valid realisation, sample k using
-  // the deviates of index k and the increment over (t_k, t_k+1] those of index k.
-  std::optional<ImuErrorSimulator> imu_increments;  // constructors validate the model
-  std::optional<ImuErrorSimulator> imu_samples;
-  if (sensor != nullptr) {
-    imu_increments.emplace(sensor->model, sensor->seed, sensor->run_index, spec.rate_hz);
-    imu_samples.emplace(sensor->model, sensor->seed, sensor->run_index, spec.rate_hz);
-  }
+  // Both streams of the run (run_loop.h StreamedImu); the simulators' constructors validate the
+  // model.
+  run_loop::StreamedImu imu(&generator, sensor != nullptr ? &sensor->model : nullptr,
+                            sensor != nullptr ? sensor->seed : 0,
+                            sensor != nullptr ? sensor->run_index : 0, spec.rate_hz);
   const NavEnvironment& env = generator.environment();
   const NavState truth0 = generator.initial_state();
   const double dt_s = generator.dt_s();
 
-  std::optional<NedMechanization> ned;
-  std::optional<Seed000Mechanization> seed000;
-  NavState nav = truth0;
+  SimulationSummary summary;
+  NavState nav;
+  NavError error;
+  // Errors at every sample k = 0..n, the navigation solution of mechanization B also before its
+  // static period has ended.
+  auto report = [&](int64_t k, const auto& navigator) {
+    const TrajectorySample& ideal = imu.ideal();
+    nav = navigator.Solution(ideal.truth);
+    error = ComputeNavError(env, nav, ideal.truth);
+    Accumulate(error, &summary);
+    if (!on_step) return;
+    SimulationStep step;
+    step.k = k;
+    step.truth = &ideal.truth;
+    step.increment = &ideal.increment;
+    step.sample = &ideal.sample;
+    step.measured_increment = &imu.measured_increment();
+    step.measured_sample = &imu.measured_sample();
+    step.nav = &nav;
+    step.error = &error;
+    on_step(step);
+  };
+  auto simulate = [&](auto& navigator) {
+    using Input = typename std::decay_t<decltype(navigator)>::Input;
+    auto measure = [&](int64_t k) -> const Input& {
+      imu.Advance(k);
+      return imu.measured<Input>();
+    };
+    run_loop::RunLoop(generator.num_steps(), measure, navigator, report,
+                      [](int64_t) { return false; });
+  };
   if (spec.mechanization == MechanizationKind::kNed) {
-    ned.emplace(env, truth0, dt_s, spec.ned);
+    // Navigation from the true initial state at k = 0 (no alignment window).
+    run_loop::NedNavigator ned(
+        env, dt_s, spec.ned, /*start_step=*/0,
+        [&](const Eigen::Vector3d&, const Eigen::Vector3d&) { return truth0; },
+        [&](int64_t) {
+          const NavState& truth = imu.ideal().truth;
+          return std::pair<double, double>(truth.llh.h_m, truth.v_eb_n.z());
+        });
+    simulate(ned);
   } else {
     if (spec.seed000.static_period_s > generator.duration_s()) {
       throw SpecError(
           "navigation.seed000.static_period_s", std::to_string(spec.seed000.static_period_s),
           "at most the motion's duration (" + std::to_string(generator.duration_s()) + " s)");
     }
-    seed000.emplace(dt_s, spec.seed000);
-  }
-
-  // The sample at t = 0 is the first IMU output (the point-sample stream starts there; the
-  // increment stream starts with the interval (0, dt]).
-  const ImuIncrement zero_increment;
-  ImuSample measured_sample0 = generator.initial_sample();
-  if (imu_samples) imu_samples->Apply(generator.initial_sample(), &measured_sample0);
-  if (seed000) {
-    seed000->Update(measured_sample0);
-    nav = seed000->ToNed(env, truth0);
-  }
-
-  SimulationSummary summary;
-  NavError error = ComputeNavError(env, nav, truth0);
-  Accumulate(error, &summary);
-  if (on_step) {
-    SimulationStep step;
-    step.k = 0;
-    step.truth = &truth0;
-    step.increment = &zero_increment;
-    step.sample = &generator.initial_sample();
-    step.measured_increment = &zero_increment;
-    step.measured_sample = &measured_sample0;
-    step.nav = &nav;
-    step.error = &error;
-    on_step(step);
-  }
-
-  TrajectorySample sample;
-  ImuIncrement measured_increment;
-  ImuSample measured_sample;
-  while (generator.Next(&sample)) {
-    if (sensor != nullptr) {
-      imu_increments->Apply(sample.increment, &measured_increment);
-      imu_samples->Apply(sample.sample, &measured_sample);
-    } else {
-      measured_increment = sample.increment;
-      measured_sample = sample.sample;
-    }
-    if (ned) {
-      ned->Update(measured_increment);
-      if (spec.ned.vertical == VerticalChannel::kTruthHeight) {
-        ned->SetVertical(sample.truth.llh.h_m, sample.truth.v_eb_n.z());
-      }
-      nav = ned->state();
-    } else {
-      seed000->Update(measured_sample);
-      nav = seed000->ToNed(env, truth0);
-    }
-    error = ComputeNavError(env, nav, sample.truth);
-    Accumulate(error, &summary);
-    if (on_step) {
-      SimulationStep step;
-      step.k = generator.step();
-      step.truth = &sample.truth;
-      step.increment = &sample.increment;
-      step.sample = &sample.sample;
-      step.measured_increment = &measured_increment;
-      step.measured_sample = &measured_sample;
-      step.nav = &nav;
-      step.error = &error;
-      on_step(step);
-    }
+    run_loop::Seed000Navigator seed000(env, truth0, dt_s, spec.seed000);
+    simulate(seed000);
   }
   summary.steps = generator.step();
   summary.duration_s = static_cast<double>(summary.steps) * dt_s;
