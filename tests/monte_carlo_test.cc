@@ -202,6 +202,48 @@ TEST(MonteCarloTest, CancellationFromProgressCallbackStopsPromptly) {
   EXPECT_LT(stats.data().timings.samples_processed, 240000 / 20);
 }
 
+TEST(MonteCarloTest, TruthRejectedMidStreamThrowsTheSameErrorOnOneAndTwoThreads) {
+  // With 2 threads the lockstep runs start while the truth streams (monte_carlo.cc); a trajectory
+  // rejected part-way (climbing through the 100 km height limit after ~200 s) must stop the runs
+  // already going and give the error a 1-thread job gives, not hang or crash.
+  MonteCarloSpec spec = SmallJob();
+  spec.simulation.motion.segments.clear();
+  spec.simulation.motion.segments.push_back(StaticSegment{5.0});
+  ClimbSegment climb;
+  climb.climb_rate_m_per_s = 500.0;
+  climb.vertical_acceleration_m_per_s2 = 50.0;
+  climb.height_change_m = 2e5;
+  spec.simulation.motion.segments.push_back(climb);
+  spec.checkpoint_times_s.clear();
+  std::string messages[2];
+  for (int threads : {1, 2}) {
+    spec.threads = threads;
+    try {
+      RunMonteCarlo(spec);
+      FAIL() << "accepted with " << threads << " threads";
+    } catch (const SpecError& e) {
+      EXPECT_EQ(e.field(), "motion") << e.what();
+      messages[threads - 1] = e.what();
+    }
+  }
+  EXPECT_EQ(messages[0], messages[1]);
+  EXPECT_NE(messages[1].find("reaches height"), std::string::npos) << messages[1];
+}
+
+TEST(MonteCarloTest, CancelWhileTheTruthStreamsStopsTheOverlappedRuns) {
+  // 2 threads: the runs start with the truth; a cancel set at the first progress call (a run's
+  // first poll) stops the truth at its next check (4096 samples) and the runs at theirs.
+  MonteCarloSpec spec = SmallJob();
+  spec.simulation.motion.segments.push_back(ConstantVelocitySegment{3000.0});
+  spec.runs = 64;
+  spec.threads = 2;
+  std::atomic<bool> cancel{false};
+  const MonteCarloStatistics stats = RunMonteCarlo(
+      spec, [&](const MonteCarloProgress&) { cancel = true; }, &cancel);
+  EXPECT_TRUE(stats.cancelled());
+  EXPECT_EQ(stats.num_epochs(), 0u);
+}
+
 TEST(MonteCarloTest, ProgressEndsWithAllRunsDone) {
   MonteCarloSpec spec = SmallJob();
   MonteCarloProgress last;

@@ -13,8 +13,10 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/task_arena.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -124,11 +126,50 @@ JobPlan PlanJob(const MonteCarloSpec& spec, const TrajectoryGenerator& generator
 uint64_t MemoryOfPlan(const MonteCarloSpec& spec, const JobPlan& plan, double rate_hz);
 
 // ---- mc_shared_truth.cc
+// The shared truth published while it streams, so that runs can start before it is complete
+// (RunMonteCarlo overlaps the truth with the lockstep runs): samples 0 .. ready are written
+// (increments, truth heights, the truth of reports at those samples, the start state).
+inline constexpr int64_t kTruthPublishSamples = 1024;  // a power of two
+class TruthStream {
+ public:
+  void Publish(int64_t k) {
+    ready_.store(k, std::memory_order_release);
+    ready_.notify_all();
+  }
+  // No more samples will come (cancelled or failed): waiting readers return false.
+  void Stop() {
+    ready_.store(kStopped, std::memory_order_release);
+    ready_.notify_all();
+  }
+  // Blocks until sample k is written (true) or the stream stopped (false).
+  bool WaitFor(int64_t k) const {
+    int64_t r = ready_.load(std::memory_order_acquire);
+    while (r < k) {
+      if (r == kStopped) return false;
+      ready_.wait(r, std::memory_order_acquire);
+      r = ready_.load(std::memory_order_acquire);
+    }
+    return true;
+  }
+
+ private:
+  static constexpr int64_t kStopped = INT64_MIN;
+  std::atomic<int64_t> ready_{-1};
+};
+
 // Generates the truth once and keeps what the runs need (without keep_imu: only the layout, the
 // reports and the start state, for ReplayMonteCarloRun). `cancel` is polled while the trajectory
 // streams (every 4096 samples); when it is set the function returns early with `cancelled`.
 SharedTruth BuildSharedTruth(const MonteCarloSpec& spec, bool keep_imu = true,
                              const std::atomic<bool>* cancel = nullptr, bool* cancelled = nullptr);
+// BuildSharedTruth in two steps: the layout (sizes, reports, aiding decimations, start state;
+// returns the generator positioned at sample 0), then the stream of samples 1..n, published to
+// `stream` (if not null) every kTruthPublishSamples samples and at the end.
+std::unique_ptr<TrajectoryGenerator> PrepareSharedTruth(const MonteCarloSpec& spec, bool keep_imu,
+                                                        SharedTruth* out);
+void StreamSharedTruth(const MonteCarloSpec& spec, bool keep_imu, TrajectoryGenerator* generator,
+                       SharedTruth* out, const std::atomic<bool>* cancel, bool* cancelled,
+                       TruthStream* stream);
 // The error-state model the EKF and the covariance analysis use (MakeErrorStateNoise of the
 // filter's IMU model, spec.filter_sensor or else the truth's), with the GNSS and barometer
 // Gauss-Markov errors as states for the EKF, and the run's time scales and motion bounds.
@@ -165,12 +206,15 @@ bool RunComplementary(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t
 
 // ---- mc_lockstep_runs.cc
 // All runs of a kNed job in lockstep groups of kernel.width runs, in parallel over groups.
+// With a `truth` stream the shared truth is still being written: each group waits for the samples
+// it needs, returns when the stream stops, and decides the gyrocompass itself once the start
+// state is there (UseGyrocompass: the same decision as `gyrocompass`).
 void RunNedLockstep(const SharedTruth& s, const MonteCarloSpec& spec,
                     const lockstep::Kernel& kernel, bool gyrocompass, uint32_t run_count,
                     tbb::task_arena& arena,
                     tbb::enumerable_thread_specific<EpochAccumulator>& accumulators,
                     std::vector<std::vector<ErrorComponentValues>>& checkpoint_values,
-                    Monitor* monitor);
+                    Monitor* monitor, const TruthStream* truth = nullptr);
 
 // ---- mc_reduction.cc
 // The per-thread epoch sums merged (exact sums: the order does not change a bit).

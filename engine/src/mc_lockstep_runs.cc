@@ -20,7 +20,7 @@ namespace {
 bool RunNedGroup(const SharedTruth& s, const MonteCarloSpec& spec, const lockstep::LockstepJob& job,
                  const lockstep::Kernel& kernel, uint32_t slot_begin, uint32_t slot_end,
                  bool gyrocompass, RunSink sink, Monitor* monitor, lockstep::LockstepGroup* group,
-                 lockstep::GroupStreams* streams) {
+                 lockstep::GroupStreams* streams, const TruthStream* truth) {
   using lockstep::kBlock;
   const int lanes = static_cast<int>(slot_end - slot_begin);
   group->lanes = lanes;
@@ -50,20 +50,22 @@ bool RunNedGroup(const SharedTruth& s, const MonteCarloSpec& spec, const lockste
   };
   // Navigation starts at s0 from the alignment sums of k = 1..s0 (RunNed).
   auto start_navigation = [&] {
+    const bool use_gyrocompass = truth != nullptr ? UseGyrocompass(spec, s) : gyrocompass;
     for (int lane = 0; lane < lanes; ++lane) {
       const uint32_t run = spec.first_run + slot_begin + static_cast<uint32_t>(lane);
       const lockstep::NavLanes& n = group->nav;
       const Eigen::Vector3d sum_dtheta(n.sum_dtheta[0][lane], n.sum_dtheta[1][lane],
                                        n.sum_dtheta[2][lane]);
       const Eigen::Vector3d sum_dv(n.sum_dv[0][lane], n.sum_dv[1][lane], n.sum_dv[2][lane]);
-      lockstep::SetNavLane(NedStartState(s, spec, run, gyrocompass, sum_dtheta, sum_dv), lane,
-                           group);
+      lockstep::SetNavLane(NedStartState(s, spec, run, use_gyrocompass, sum_dtheta, sum_dv),
+                           lane, group);
     }
     if (s.reports[0].k == s.start_step) {
       record(s.reports[0]);
       next = 1;
     }
   };
+  if (truth != nullptr && !truth->WaitFor(0)) return false;
   if (s.start_step == 0) start_navigation();
   // Polls every poll_every samples, so that a poll covers about kPollSamples run-samples as in
   // RunNed (a power of two, a multiple of the deviate block).
@@ -79,6 +81,7 @@ bool RunNedGroup(const SharedTruth& s, const MonteCarloSpec& spec, const lockste
     const bool navigate = k > s.start_step;
     if (!navigate) end = std::min<int64_t>(end, s.start_step + 1);
     if (navigate && next < n_reports) end = std::min<int64_t>(end, s.reports[next].k + 1);
+    if (truth != nullptr && !truth->WaitFor(end - 1)) return false;
     kernel.advance(job.kernel, in, k, end, navigate, group);
     const int64_t last = end - 1;
     if (!navigate && last == s.start_step) start_navigation();
@@ -101,7 +104,7 @@ void RunNedLockstep(const SharedTruth& s, const MonteCarloSpec& spec,
                     tbb::task_arena& arena,
                     tbb::enumerable_thread_specific<EpochAccumulator>& accumulators,
                     std::vector<std::vector<ErrorComponentValues>>& checkpoint_values,
-                    Monitor* monitor) {
+                    Monitor* monitor, const TruthStream* truth) {
   const lockstep::LockstepJob job = lockstep::ComposeJob(
       spec.sensor ? &*spec.sensor : nullptr, spec.seed, s.env, s.rate_hz, spec.simulation.ned);
   const uint32_t width = static_cast<uint32_t>(kernel.width);
@@ -123,7 +126,7 @@ void RunNedLockstep(const SharedTruth& s, const MonteCarloSpec& spec,
                           const uint32_t begin = g * width;
                           const uint32_t end = std::min(run_count, begin + width);
                           if (!RunNedGroup(s, spec, job, kernel, begin, end, gyrocompass, sink,
-                                           monitor, w.group.get(), &w.streams)) {
+                                           monitor, w.group.get(), &w.streams, truth)) {
                             return;
                           }
                         }

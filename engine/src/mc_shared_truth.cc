@@ -2,6 +2,7 @@
 // model the filter and the covariance analysis derive from it.
 #include <algorithm>
 #include <atomic>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -13,8 +14,18 @@ namespace driftlab::mc_detail {
 
 SharedTruth BuildSharedTruth(const MonteCarloSpec& spec, bool keep_imu,
                              const std::atomic<bool>* cancel, bool* cancelled) {
-  TrajectoryGenerator generator(spec.simulation.motion, spec.simulation.rate_hz);
   SharedTruth s;
+  const std::unique_ptr<TrajectoryGenerator> generator = PrepareSharedTruth(spec, keep_imu, &s);
+  StreamSharedTruth(spec, keep_imu, generator.get(), &s, cancel, cancelled, nullptr);
+  return s;
+}
+
+std::unique_ptr<TrajectoryGenerator> PrepareSharedTruth(const MonteCarloSpec& spec, bool keep_imu,
+                                                        SharedTruth* out) {
+  auto owned_generator =
+      std::make_unique<TrajectoryGenerator>(spec.simulation.motion, spec.simulation.rate_hz);
+  const TrajectoryGenerator& generator = *owned_generator;
+  SharedTruth& s = *out;
   s.env = generator.environment();
   s.dt_s = generator.dt_s();
   s.rate_hz = generator.rate_hz();
@@ -66,6 +77,18 @@ SharedTruth BuildSharedTruth(const MonteCarloSpec& spec, bool keep_imu,
     s.h_m[0] = s.truth0.llh.h_m;
     s.v_D_m_per_s[0] = s.truth0.v_eb_n.z();
   }
+  return owned_generator;
+}
+
+void StreamSharedTruth(const MonteCarloSpec& spec, bool keep_imu, TrajectoryGenerator* generator_in,
+                       SharedTruth* out, const std::atomic<bool>* cancel, bool* cancelled,
+                       TruthStream* stream) {
+  TrajectoryGenerator& generator = *generator_in;
+  SharedTruth& s = *out;
+  const bool seed000 = spec.simulation.mechanization == MechanizationKind::kSeed000;
+  const bool point_samples = seed000 || spec.filter == NavigationFilterKind::kComplementary;
+  const bool truth_height =
+      keep_imu && !seed000 && spec.simulation.ned.vertical == VerticalChannel::kTruthHeight;
   size_t next_report = 0;
   auto keep_truth = [&](int64_t k, const NavState& truth) {
     if (k == s.start_step) s.truth_start = truth;
@@ -74,12 +97,13 @@ SharedTruth BuildSharedTruth(const MonteCarloSpec& spec, bool keep_imu,
     }
   };
   keep_truth(0, s.truth0);
+  if (stream != nullptr) stream->Publish(0);
   TrajectorySample sample;
   while (generator.Next(&sample)) {
     const int64_t k = generator.step();
     if (cancel != nullptr && (k & 4095) == 0 && cancel->load(std::memory_order_relaxed)) {
       if (cancelled != nullptr) *cancelled = true;
-      return s;
+      return;
     }
     const size_t uk = static_cast<size_t>(k);
     if (keep_imu && point_samples) {
@@ -103,8 +127,9 @@ SharedTruth BuildSharedTruth(const MonteCarloSpec& spec, bool keep_imu,
       s.v_D_m_per_s[uk] = sample.truth.v_eb_n.z();
     }
     keep_truth(k, sample.truth);
+    if (stream != nullptr && (k & (kTruthPublishSamples - 1)) == 0) stream->Publish(k);
   }
-  return s;
+  if (stream != nullptr) stream->Publish(s.n);
 }
 
 ErrorStateNoiseFromImu FilterErrorModel(const MonteCarloSpec& spec, const SharedTruth& s) {

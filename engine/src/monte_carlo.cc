@@ -6,8 +6,11 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
 #include <tbb/task_arena.h>
 
+#include <exception>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -20,7 +23,6 @@
 
 namespace driftlab {
 
-using mc_detail::BuildSharedTruth;
 using mc_detail::Clock;
 using mc_detail::EpochAccumulator;
 using mc_detail::FilterErrorModel;
@@ -28,6 +30,7 @@ using mc_detail::MergeEpochSums;
 using mc_detail::MergeNees;
 using mc_detail::Monitor;
 using mc_detail::NeesAccumulator;
+using mc_detail::PrepareSharedTruth;
 using mc_detail::Report;
 using mc_detail::RunComplementary;
 using mc_detail::RunEkf;
@@ -35,6 +38,8 @@ using mc_detail::RunNed;
 using mc_detail::RunNedLockstep;
 using mc_detail::RunSeed000;
 using mc_detail::RunSink;
+using mc_detail::StreamSharedTruth;
+using mc_detail::TruthStream;
 using mc_detail::Seconds;
 using mc_detail::SharedTruth;
 using mc_detail::UseGyrocompass;
@@ -54,9 +59,38 @@ MonteCarloOutput RunMonteCarloWithAnalysis(
   ValidateMonteCarloSpec(spec);
   const uint32_t run_count = spec.run_count == 0 ? spec.runs - spec.first_run : spec.run_count;
 
+  const bool ekf = spec.filter == NavigationFilterKind::kInsGnssEkf;
+  const bool complementary = spec.filter == NavigationFilterKind::kComplementary;
+  const bool seed000 = spec.simulation.mechanization == MechanizationKind::kSeed000;
+  const int threads = spec.threads > 0 ? spec.threads : tbb::info::default_concurrency();
+  // Mechanization A without a filter runs in lockstep groups (DRIFTLAB_ISA=scalar: one run at a
+  // time, RunNed, kept as the reference the lockstep path must match bit for bit).
+  const bool run_lockstep = !seed000 && !ekf && !complementary && !lockstep::ScalarForced();
+  // With two or more threads the lockstep runs start while the truth streams: this thread
+  // generates it while the others run the groups as far as it has come (the truth is the job's
+  // serial part: 5-20 % of a one-thread job). The same computations, so the same bits.
+  const bool overlap_truth = run_lockstep && threads >= 2 && !spec.covariance;
+
+  SharedTruth shared;
+  const std::unique_ptr<TrajectoryGenerator> generator = PrepareSharedTruth(spec, true, &shared);
   bool cancelled_early = false;
-  SharedTruth shared = BuildSharedTruth(spec, true, cancel, &cancelled_early);
-  if (cancelled_early) {
+  double truth_s = 0.0;
+  ErrorStateNoiseFromImu noise;
+  // The truth's samples, then the error-state model the filter and the analysis assume (no
+  // sensor: no process noise, no bias uncertainty).
+  auto finish_truth = [&](TruthStream* stream) {
+    StreamSharedTruth(spec, true, generator.get(), &shared, cancel, &cancelled_early, stream);
+    if (cancelled_early) return;
+    noise = FilterErrorModel(spec, shared);
+    if (ekf || spec.covariance) {
+      shared.ekf_noise = noise.noise;
+      shared.ekf_P0 = InitialErrorCovariance(
+          spec.initial_errors.position_ned_m, spec.initial_errors.velocity_ned_m_per_s,
+          spec.initial_errors.attitude_rad, shared.truth_start.euler(), noise.noise);
+    }
+    truth_s = Seconds(start);
+  };
+  auto cancelled_during_truth = [&] {
     MonteCarloOutput output;
     MonteCarloStatisticsData data;
     data.seed = spec.seed;
@@ -66,23 +100,14 @@ MonteCarloOutput RunMonteCarloWithAnalysis(
     data.timings.wall_s = data.timings.truth_s;
     output.statistics = MonteCarloStatistics(std::move(data));
     return output;
-  }
-  const bool ekf = spec.filter == NavigationFilterKind::kInsGnssEkf;
-  const bool complementary = spec.filter == NavigationFilterKind::kComplementary;
-  // The error-state model the filter and the analysis assume (no sensor: no process noise, no
-  // bias uncertainty).
-  const ErrorStateNoiseFromImu noise = FilterErrorModel(spec, shared);
-  if (ekf || spec.covariance) {
-    shared.ekf_noise = noise.noise;
-    shared.ekf_P0 = InitialErrorCovariance(
-        spec.initial_errors.position_ned_m, spec.initial_errors.velocity_ned_m_per_s,
-        spec.initial_errors.attitude_rad, shared.truth_start.euler(), noise.noise);
+  };
+  if (!overlap_truth) {
+    finish_truth(nullptr);
+    if (cancelled_early) return cancelled_during_truth();
   }
   const SharedTruth& truth = shared;
-  const double truth_s = Seconds(start);
-  const bool seed000 = spec.simulation.mechanization == MechanizationKind::kSeed000;
-
-  const bool gyrocompass = UseGyrocompass(spec, truth);
+  // Overlapped: decided by each lockstep group once the start state is there.
+  const bool gyrocompass = overlap_truth ? false : UseGyrocompass(spec, truth);
 
   // Output buffers: per-run checkpoint values (each run writes its own slot), per-thread sums.
   size_t n_epochs = 0, n_checkpoints = 0;
@@ -108,12 +133,34 @@ MonteCarloOutput RunMonteCarloWithAnalysis(
 
   const int64_t samples_per_run = seed000 || complementary ? truth.n + 1 : truth.n;
   Monitor monitor(progress, cancel, run_count, samples_per_run * int64_t{run_count}, start);
-  const int threads = spec.threads > 0 ? spec.threads : tbb::info::default_concurrency();
   tbb::task_arena arena(threads);
-  // Mechanization A without a filter runs in lockstep groups (DRIFTLAB_ISA=scalar: one run at a
-  // time, RunNed, kept as the reference the lockstep path must match bit for bit).
-  const bool run_lockstep = !seed000 && !ekf && !complementary && !lockstep::ScalarForced();
-  if (run_lockstep) {
+  if (run_lockstep && overlap_truth) {
+    // The runs go to the arena's worker threads; this thread streams the truth and then joins
+    // them (task_arena + task_group: the arena keeps this thread's slot until it comes back).
+    TruthStream stream;
+    tbb::task_group runs;
+    const lockstep::Kernel& kernel = lockstep::SelectKernel();
+    arena.execute([&] {
+      runs.run([&] {
+        RunNedLockstep(truth, spec, kernel, gyrocompass, run_count, arena, accumulators,
+                       checkpoint_values, &monitor, &stream);
+      });
+    });
+    std::exception_ptr truth_error;
+    try {
+      finish_truth(&stream);
+    } catch (...) {
+      truth_error = std::current_exception();
+    }
+    if (truth_error || cancelled_early) stream.Stop();
+    try {
+      arena.execute([&] { runs.wait(); });
+    } catch (...) {
+      if (!truth_error) throw;
+    }
+    if (truth_error) std::rethrow_exception(truth_error);
+    if (cancelled_early) return cancelled_during_truth();
+  } else if (run_lockstep) {
     RunNedLockstep(truth, spec, lockstep::SelectKernel(), gyrocompass, run_count, arena,
                    accumulators, checkpoint_values, &monitor);
   }
