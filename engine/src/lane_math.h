@@ -51,6 +51,35 @@ template <int W>
 inline U<W> GreaterMask(U<W> a, U<W> b) {
   return U<W>{} - ((b - a) >> 63);
 }
+// Lane i of a vector (W = 1: the value itself), read and written; the kernels' few per-lane
+// steps (clamp, floor, "any lane") go through these so that they also compile for W = 1.
+template <int W>
+inline double GetLane(D<W> v, int i) {
+  if constexpr (W == 1) {
+    (void)i;
+    return v;
+  } else {
+    return v[i];
+  }
+}
+template <int W>
+inline uint64_t GetLane(U<W> v, int i) {
+  if constexpr (W == 1) {
+    (void)i;
+    return v;
+  } else {
+    return v[i];
+  }
+}
+template <int W>
+inline void SetLane(D<W>& v, int i, double x) {
+  if constexpr (W == 1) {
+    (void)i;
+    v = x;
+  } else {
+    v[i] = x;
+  }
+}
 template <int W>
 inline D<W> Splat(double x) {
   if constexpr (W == 1) {
