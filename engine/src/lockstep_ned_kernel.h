@@ -255,17 +255,12 @@ struct Kernel {
       P v = y + e;
       if (p.range > 0.0) {
         const double lo = -p.range * weight, hi = p.range * weight;
-        for (int l = 0; l < W; ++l) {
-          const double x = lane_math::GetLane<W>(v, l);
-          lane_math::SetLane<W>(v, l, x < lo ? lo : (hi < x ? hi : x));
-        }
+        v = lane_math::Clamp<W>(v, lo, hi);
       }
       if (p.quantization > 0.0) {
         const double lsb = p.quantization;
         const P carried = v + Load(t.remainder[i]);
-        P q = carried / lsb + 0.5;
-        for (int l = 0; l < W; ++l)
-          lane_math::SetLane<W>(q, l, __builtin_floor(lane_math::GetLane<W>(q, l)));
+        const P q = lane_math::Floor<W>(carried / lsb + 0.5);
         const P o = lsb * q;
         Store(t.remainder[i], carried - o);
         v = o;
