@@ -208,45 +208,46 @@ struct Kernel {
     return row < 2 ? (a0 + a1) + a2 : a0 + (a1 + a2);
   }
 
-  // ---- Sensor error step (TriadErrorSimulator::Apply<true>)
-  // -------------------------------------- `ideal` and `additive` are the same for every lane (the
-  // shared truth); the result per lane.
-  static V3 TriadStep(const TriadParams& p, TriadLanes& t, const double ideal[3],
-                      const double additive[3], uint64_t k, int j_block, uint64_t block_begin,
-                      double dt) {
+  // ---- Sensor error step (TriadErrorSimulator::Apply<true> runs it at W = 1) -------------------
+  // `p` has TriadParams's fields, `t` TriadLanes's run-state fields (lane arrays, or plain doubles
+  // for W = 1: sensors.cc), `dev` the step's deviates (White(i), GmW1(i), GmW2(i), RwW1(i),
+  // RwW2(i), and Flicker(i, j, k, m) for component j of period 2^m at step k). `ideal` and
+  // `additive` are the same for every lane (the shared truth); the result per lane.
+  template <typename Params, typename State, typename Deviates>
+  static V3 TriadStep(const Params& p, State& t, const Deviates& dev, const double ideal[3],
+                      const double additive[3], uint64_t k, double dt) {
     double out[3][W];
     const double weight = dt;
     for (int i = 0; i < 3; ++i) {
-      const P m0 = Load(t.scale_misalignment[i][0]);
-      const P m1 = Load(t.scale_misalignment[i][1]);
-      const P m2 = Load(t.scale_misalignment[i][2]);
+      const P m0 = Get(t.scale_misalignment[i][0]);
+      const P m1 = Get(t.scale_misalignment[i][1]);
+      const P m2 = Get(t.scale_misalignment[i][2]);
       P y = Dot3(i, m0 * ideal[0], m1 * ideal[1], m2 * ideal[2]) + additive[i];
       if (p.asymmetry) y = y + p.half_asymmetry[i] * __builtin_fabs(ideal[i]);
-      P e = Load(t.constant_bias[i]) * weight;
-      if (p.white) e = e + p.white_increment * Load(t.white[i][j_block]);
+      P e = Get(t.constant_bias[i]) * weight;
+      if (p.white) e = e + p.white_increment * dev.White(i);
       if (p.gauss_markov) {
-        const P w1 = Load(t.gm_w1[i][j_block]);
-        const P b = Load(t.gm_state[i]);
-        e = e + (p.gm_mean_gain * b + p.gm_integral_w1_gain * w1 +
-                 p.gm_integral_w2_gain * Load(t.gm_w2[i][j_block]));
-        Store(t.gm_state[i], p.gm_decay * b + p.gm_drive_sigma * w1);
+        const P w1 = dev.GmW1(i);
+        const P b = Get(t.gm_state[i]);
+        e = e +
+            (p.gm_mean_gain * b + p.gm_integral_w1_gain * w1 + p.gm_integral_w2_gain * dev.GmW2(i));
+        Put(t.gm_state[i], p.gm_decay * b + p.gm_drive_sigma * w1);
       }
       if (p.random_walk) {
-        const P step = p.rw_step_sigma * Load(t.rw_w1[i][j_block]);
-        const P b = Load(t.rw_state[i]);
-        e = e + (b * dt + 0.5 * dt * step + p.rw_bridge_sigma * Load(t.rw_w2[i][j_block]));
-        Store(t.rw_state[i], b + step);
+        const P step = p.rw_step_sigma * dev.RwW1(i);
+        const P b = Get(t.rw_state[i]);
+        e = e + (b * dt + 0.5 * dt * step + p.rw_bridge_sigma * dev.RwW2(i));
+        Put(t.rw_state[i], b + step);
       }
       if (p.n_flicker > 0) {
         P sum = Splat(0.0);
         for (int j = 0; j < p.n_flicker; ++j) {
           const int m = p.flicker_period_log2[j];
           const uint64_t mask = (uint64_t{1} << m) - 1;
-          P x = Load(t.flicker_state[i][j]);
+          P x = Get(t.flicker_state[i][j]);
           if (k != 0 && (k & mask) == 0) {
-            x = p.flicker_decay[j] * x +
-                p.flicker_drive_sigma[j] * Load(t.flicker_w[i][j][(k - block_begin) >> m]);
-            Store(t.flicker_state[i][j], x);
+            x = p.flicker_decay[j] * x + p.flicker_drive_sigma[j] * dev.Flicker(i, j, k, m);
+            Put(t.flicker_state[i][j], x);
           }
           sum = sum + x;
         }
@@ -259,10 +260,10 @@ struct Kernel {
       }
       if (p.quantization > 0.0) {
         const double lsb = p.quantization;
-        const P carried = v + Load(t.remainder[i]);
+        const P carried = v + Get(t.remainder[i]);
         const P q = lane_math::Floor<W>(carried / lsb + 0.5);
         const P o = lsb * q;
-        Store(t.remainder[i], carried - o);
+        Put(t.remainder[i], carried - o);
         v = o;
       }
       Store(out[i], v);
@@ -400,6 +401,21 @@ struct Kernel {
     Put3(n.v_eb_n, corrected.v);
   }
 
+  // The deviates of one step of a lane group: [axis][j][lane] of the block's buffers (TriadLanes).
+  struct LaneDeviates {
+    const TriadLanes& t;
+    int j;                 // step - block_begin
+    uint64_t block_begin;  // first step of the block
+    P White(int i) const { return Load(t.white[i][j]); }
+    P GmW1(int i) const { return Load(t.gm_w1[i][j]); }
+    P GmW2(int i) const { return Load(t.gm_w2[i][j]); }
+    P RwW1(int i) const { return Load(t.rw_w1[i][j]); }
+    P RwW2(int i) const { return Load(t.rw_w2[i][j]); }
+    P Flicker(int i, int c, uint64_t k, int m) const {
+      return Load(t.flicker_w[i][c][(k - block_begin) >> m]);
+    }
+  };
+
   // Sample k (increment over (t_{k-1}, t_k]) is the sensor's step d = k - 1 (its deviate index,
   // TriadErrorSimulator::step()); the block holds the deviates of steps [block_begin, +kBlock).
   static void Advance(const KernelJob& job, const KernelInputs& in, int64_t k_begin, int64_t k_end,
@@ -420,9 +436,10 @@ struct Kernel {
           }
         }
         const double zero[3] = {0.0, 0.0, 0.0};
-        dtheta =
-            TriadStep(job.triad[0], group->triad[0], ideal, g_term, d, j, block_begin, job.dt_s);
-        dv = TriadStep(job.triad[1], group->triad[1], ideal + 3, zero, d, j, block_begin, job.dt_s);
+        const LaneDeviates gyro{group->triad[0], j, block_begin};
+        const LaneDeviates accel{group->triad[1], j, block_begin};
+        dtheta = TriadStep(job.triad[0], group->triad[0], gyro, ideal, g_term, d, job.dt_s);
+        dv = TriadStep(job.triad[1], group->triad[1], accel, ideal + 3, zero, d, job.dt_s);
       } else {
         dtheta = Splat3(ideal[0], ideal[1], ideal[2]);
         dv = Splat3(ideal[3], ideal[4], ideal[5]);
