@@ -2,19 +2,20 @@
 // W and compiled once per instruction set (lockstep_ned_{baseline,avx2,avx512}.cc include this
 // file). Everything here has internal linkage and uses no Eigen or standard-library templates:
 // each kernel file keeps its own copy, compiled for its instruction set only.
-// At W = 1 (plain double) it is also the scalar code: NedMechanization::Update (ins.cc) is
-// NedStep at one lane, so the mechanization step exists once.
+// At W = 1 (plain double) it is also the scalar code, so each step exists once:
+// NedMechanization::Update (ins.cc) is NedStep at one lane, TriadErrorSimulator::ApplyIncrement
+// (sensors.cc) is TriadStep at one lane; both files include this header (internal linkage, their
+// own compile options).
 //
 // The arithmetic is lane-wise IEEE (GCC vector extensions: +, -, *, / and sqrt are correctly
-// rounded per lane whatever the vector width) with -ffp-contract=off, and each expression is the
-// scalar code's, operation for operation and in the same order:
-//  * sensor error step: TriadErrorSimulator::Apply<true> (sensors.cc);
-//  * mechanization: the Eigen code NedMechanization::Update had before it ran this kernel, with
-//    NavEnvironment (earth.cc) and RotationVectorToQuaternion (attitude.cc); Eigen 3.4's order of
-//    operations for its small fixed-size expressions: Matrix3d * Vector3d as Dot3 below,
-//    squaredNorm of a 3-vector as x0 + (x1 + x2) (its unrolled reduction halves the range), the
-//    quaternion product as its SSE2/NEON kernel (Geometry_SIMD.h), q * v as _transformVector,
-//    normalized() as division by sqrt of (x^2 + z^2) + (y^2 + w^2) (two-lane packets).
+// rounded per lane whatever the vector width) with -ffp-contract=off. The order of operations is
+// that of the Eigen code the scalar steps were before they ran this kernel (kept so that results
+// did not change), with NavEnvironment (earth.cc) and RotationVectorToQuaternion (attitude.cc):
+// Eigen 3.4's order of operations for its small fixed-size expressions: Matrix3d * Vector3d as
+// Dot3 below, squaredNorm of a 3-vector as x0 + (x1 + x2) (its unrolled reduction halves the
+// range), the quaternion product as its SSE2/NEON kernel (Geometry_SIMD.h), q * v as
+// _transformVector, normalized() as division by sqrt of (x^2 + z^2) + (y^2 + w^2) (two-lane
+// packets).
 // sin and cos are the engine's own (lane_math.h, also used by the scalar earth.cc and attitude.cc),
 // computed for all W lanes at once; tan L is sin L / cos L in both.
 #pragma once
@@ -208,7 +209,7 @@ struct Kernel {
     return row < 2 ? (a0 + a1) + a2 : a0 + (a1 + a2);
   }
 
-  // ---- Sensor error step (TriadErrorSimulator::Apply<true> runs it at W = 1) -------------------
+  // ---- Sensor error step (TriadErrorSimulator::ApplyIncrement runs it at W = 1) ---------------
   // `p` has TriadParams's fields, `t` TriadLanes's run-state fields (lane arrays, or plain doubles
   // for W = 1: sensors.cc), `dev` the step's deviates (White(i), GmW1(i), GmW2(i), RwW1(i),
   // RwW2(i), and Flicker(i, j, k, m) for component j of period 2^m at step k). `ideal` and

@@ -400,58 +400,53 @@ TriadErrorSimulator::TriadErrorSimulator(const TriadErrorParams& params, SensorI
   p.quantization = quantization_;
 }
 
-template <bool kIncrement>
-Eigen::Vector3d TriadErrorSimulator::Apply(const Eigen::Vector3d& ideal,
-                                           const Eigen::Vector3d& additive) {
+Eigen::Vector3d TriadErrorSimulator::ApplyIncrement(const Eigen::Vector3d& ideal,
+                                                    const Eigen::Vector3d& additive) {
   const double dt = dt_s_;
-  const double weight = kIncrement ? dt : 1.0;  // constant rate -> increment or sample
   const uint64_t k = static_cast<uint64_t>(step_);
-  if constexpr (kIncrement) {
-    // The lockstep kernel's step at one lane, its deviates from this run's channels.
-    struct Deviates {
-      TriadErrorSimulator* s;
-      uint64_t k;
-      double At(int first, int axis) const { return s->channels_[first + axis].At(k); }
-      double White(int i) const { return At(s->white_ch_, i); }
-      double GmW1(int i) const { return At(s->gm_ch_, i); }
-      double GmW2(int i) const { return At(s->gm_int_ch_, i); }
-      double RwW1(int i) const { return At(s->rw_ch_, i); }
-      double RwW2(int i) const { return At(s->rw_int_ch_, i); }
-      double Flicker(int i, int j, uint64_t step, int m) const {
-        return s->channels_[s->flicker_ch_ + i * s->n_flicker_ + j].At((step >> m) - 1);
-      }
-    };
-    const Deviates dev{this, k};
-    const auto out = lockstep::Kernel<1>::TriadStep(step_params_, state_, dev, ideal.data(),
-                                                    additive.data(), k, dt);
-    ++step_;
-    return Eigen::Vector3d(out.x, out.y, out.z);
-  }
+  // The lockstep kernel's step at one lane, its deviates from this run's channels.
+  struct Deviates {
+    TriadErrorSimulator* s;
+    uint64_t k;
+    double At(int first, int axis) const { return s->channels_[first + axis].At(k); }
+    double White(int i) const { return At(s->white_ch_, i); }
+    double GmW1(int i) const { return At(s->gm_ch_, i); }
+    double GmW2(int i) const { return At(s->gm_int_ch_, i); }
+    double RwW1(int i) const { return At(s->rw_ch_, i); }
+    double RwW2(int i) const { return At(s->rw_int_ch_, i); }
+    double Flicker(int i, int j, uint64_t step, int m) const {
+      return s->channels_[s->flicker_ch_ + i * s->n_flicker_ + j].At((step >> m) - 1);
+    }
+  };
+  const Deviates dev{this, k};
+  const auto out = lockstep::Kernel<1>::TriadStep(step_params_, state_, dev, ideal.data(),
+                                                  additive.data(), k, dt);
+  ++step_;
+  return Eigen::Vector3d(out.x, out.y, out.z);
+}
+
+// A point sample: the increment step's terms as rates (weight 1 instead of dt), the Gauss-Markov
+// and random-walk states as they are at the instant, white noise N / sqrt(dt), the quantization
+// LSB divided by dt.
+Eigen::Vector3d TriadErrorSimulator::ApplySample(const Eigen::Vector3d& ideal,
+                                                 const Eigen::Vector3d& additive) {
+  const double dt = dt_s_;
+  const uint64_t k = static_cast<uint64_t>(step_);
   Eigen::Vector3d y = scale_misalignment_ * ideal + additive;
   if (has_asymmetry_) y += half_asymmetry_.cwiseProduct(ideal.cwiseAbs());  // sign(x) a/2 x
   for (int i = 0; i < 3; ++i) {
-    double e = constant_bias_[i] * weight;
-    if (white_ch_ >= 0) {
-      e += (kIncrement ? white_increment_ : white_sample_) * channels_[white_ch_ + i].At(k);
-    }
+    double e = constant_bias_[i];
+    if (white_ch_ >= 0) e += white_sample_ * channels_[white_ch_ + i].At(k);
     if (gm_ch_ >= 0) {
       const double w1 = channels_[gm_ch_ + i].At(k);
       double& b = state_.gm_state[i];
-      if constexpr (kIncrement) {
-        e += gm_mean_gain_ * b + gm_c_ * w1 + gm_d_ * channels_[gm_int_ch_ + i].At(k);
-      } else {
-        e += b;
-      }
+      e += b;
       b = gm_a_ * b + gm_drive_ * w1;
     }
     if (rw_ch_ >= 0) {
       const double step = rw_step_ * channels_[rw_ch_ + i].At(k);
       double& b = state_.rw_state[i];
-      if constexpr (kIncrement) {
-        e += b * dt + 0.5 * dt * step + rw_bridge_ * channels_[rw_int_ch_ + i].At(k);
-      } else {
-        e += b;
-      }
+      e += b;
       b += step;
     }
     if (n_flicker_ > 0) {
@@ -466,12 +461,12 @@ Eigen::Vector3d TriadErrorSimulator::Apply(const Eigen::Vector3d& ideal,
         }
         sum += x[j];
       }
-      e += sum * weight;
+      e += sum;
     }
     double v = y[i] + e;
-    if (range_ > 0.0) v = std::clamp(v, -range_ * weight, range_ * weight);
+    if (range_ > 0.0) v = std::clamp(v, -range_, range_);
     if (quantization_ > 0.0) {
-      const double lsb = kIncrement ? quantization_ : quantization_ / dt;
+      const double lsb = quantization_ / dt;
       const double carried = v + state_.remainder[i];
       const double out = lsb * std::floor(carried / lsb + 0.5);
       state_.remainder[i] = carried - out;
@@ -481,16 +476,6 @@ Eigen::Vector3d TriadErrorSimulator::Apply(const Eigen::Vector3d& ideal,
   }
   ++step_;
   return y;
-}
-
-Eigen::Vector3d TriadErrorSimulator::ApplyIncrement(const Eigen::Vector3d& ideal_increment,
-                                                    const Eigen::Vector3d& additive_increment) {
-  return Apply<true>(ideal_increment, additive_increment);
-}
-
-Eigen::Vector3d TriadErrorSimulator::ApplySample(const Eigen::Vector3d& ideal,
-                                                 const Eigen::Vector3d& additive) {
-  return Apply<false>(ideal, additive);
 }
 
 namespace {

@@ -183,8 +183,6 @@ class TriadErrorSimulator {
     void Refill(uint64_t index);
   };
 
-  template <bool kIncrement>
-  Eigen::Vector3d Apply(const Eigen::Vector3d& ideal, const Eigen::Vector3d& additive);
   Channel& ChannelAt(int first, int axis) { return channels_[first + axis]; }
 
   double dt_s_ = 0.0;
