@@ -5,26 +5,34 @@
 #include <string>
 
 #include "driftlab/spec_error.h"
+// The lane kernel has internal linkage (its own anonymous namespace): this file's Kernel<1> is
+// compiled with this file's options only and shares no inline code with the kernel files built
+// for other instruction sets.
+#include "lockstep_ned_kernel.h"
 
 namespace driftlab {
 
 namespace {
 
-// Position update by the trapezoidal rule on (L, lambda, h), Groves (5.56)-style: the rate of
-// (L, lambda, h) is evaluated with the old velocity at the old position (rate_old) and with the new
-// velocity at the new position. The new latitude inside the second evaluation only scales R_N, R_E
-// and cos L, so a predicted value (error O(dt^2)) is enough: it enters the step at O(dt^3 v / R^2).
-Llh TrapezoidPosition(const NavEnvironment& env, const Llh& llh, const Vector3d& rate_old,
-                      const Vector3d& v_old, const Vector3d& v_new, double L_new_predicted,
-                      double dt_s) {
-  const double h_new = llh.h_m - 0.5 * dt_s * (v_old.z() + v_new.z());
-  const Vector3d rate_new = env.LlhRate(L_new_predicted, h_new, v_new);
-  Llh out;
-  out.lat_rad = llh.lat_rad + 0.5 * dt_s * (rate_old.x() + rate_new.x());
-  out.lon_rad = llh.lon_rad + 0.5 * dt_s * (rate_old.y() + rate_new.y());
-  out.h_m = h_new;
-  return out;
-}
+using Kernel1 = lockstep::Kernel<1>;
+
+// What Kernel<1>::NedStep reads of the job (lockstep::KernelJob's fields of the same names).
+struct NedStepJob {
+  lockstep::EarthParams earth;
+  double dt_s = 0.0;
+  int coning_sculling = 1;
+};
+
+// NedMechanization's state as Kernel<1>::NedStep reads and writes it: lockstep::NavLanes's
+// fields with one double per lane.
+struct NedStepState {
+  double lat_rad, lon_rad, h_m;
+  double v_eb_n[3];
+  double q_b_n[4];  // w, x, y, z
+  double previous_dtheta[3], previous_dv[3];
+  double previous_v_eb_n[3];
+  int have_previous;
+};
 
 // sum += x with Kahan's compensation term carried in `carry`.
 void KahanAdd(const Vector3d& x, Vector3d* sum, Vector3d* carry) {
@@ -58,107 +66,44 @@ void NedMechanization::SetVertical(double h_m, double v_D_m_per_s) {
   state_.v_eb_n.z() = v_D_m_per_s;
 }
 
-NedMechanization::Step NedMechanization::Propagate(const Vector3d& delta_v_b,
-                                                   const Vector3d& alpha_cross_dv,
-                                                   const Vector3d& second_order_b,
-                                                   const Vector3d& llh_rate_old, double L_mid,
-                                                   double h_mid, const Vector3d& v_mid) const {
-  const Vector3d& v_old = state_.v_eb_n;
-  // Navigation-frame rotation over the interval, rotation rate taken at the midpoint:
-  //   zeta = (omega_ie_n + omega_en_n)(mid) dt                               Groves (5.73)-(5.76)
-  Step s;
-  const Vector3d omega_ie_n = env_.EarthRate(L_mid);
-  const Vector3d omega_en_n = env_.TransportRate(L_mid, h_mid, v_mid);
-  const Vector3d& zeta = s.zeta = (omega_ie_n + omega_en_n) * dt_s_;
-
-  // Specific-force velocity increment resolved in n, delta_v_sf_n = integral of
-  // C_n(k)^n(t) C_b_n(k) C_b(t)^b(k) f_ib_b dt, expanded to second order in the body rotation
-  // alpha and the n-frame rotation zeta (rates constant over the interval; the linear variation
-  // is the sculling term already in delta_v_b):
-  //   integral = x + 1/2 w + 1/6 C alpha x (alpha x dv) - 1/2 zeta x x - 1/3 zeta x w
-  //              + 1/6 zeta x (zeta x x),        x = C_b_n(k) dv, w = C_b_n(k) (alpha x dv)
-  // (the -1/3 from integrating s^2 over the cross term of the two rotations). With
-  // u = x + 1/2 w = C_b_n(k) delta_v_b (delta_v_b holding dv + 1/2 alpha x dv + sculling):
-  //   delta_v_sf_n = u + 1/6 C alpha x (alpha x dv) - 1/2 zeta x u - 1/12 zeta x w
-  //                  + 1/6 zeta x (zeta x u)               + O(3rd order)
-  // Savage (1998) part 2 section 3 (the first-order form is his eq. 24).
-  // The second-order terms matter: at 10 Hz a stationary body otherwise drifts by
-  // 1/4 zeta x (zeta x g dt) ~ 1e-11 m/s per step, and in a 0.5 rad/s turn 1/6 alpha^2 dv reaches
-  // 2e-7 m/s per step at 100 Hz.
-  const Vector3d u = state_.q_b_n * delta_v_b;
-  const Vector3d delta_v_sf_n = u + state_.q_b_n * second_order_b - 0.5 * zeta.cross(u) -
-                                zeta.cross(state_.q_b_n * alpha_cross_dv) / 12.0 +
-                                zeta.cross(zeta.cross(u)) / 6.0;
-  // Gravity and Coriolis at the midpoint:
-  //   v(k+1) = v(k) + delta_v_sf_n + (g_b_n - (omega_en_n + 2 omega_ie_n) x v_eb_n)(mid) dt
-  //                                                                                 Groves (5.54)
-  const Vector3d g_b_n = env_.Gravity(L_mid, h_mid);
-  s.v_eb_n = v_old + delta_v_sf_n + (g_b_n - (omega_en_n + 2.0 * omega_ie_n).cross(v_mid)) * dt_s_;
-
-  // 2 L_mid - L_k is the midpoint-rule prediction of L_k+1 (exactly the predicted L_k+1 in the
-  // corrector, whose L_mid is the average of the two).
-  s.llh = TrapezoidPosition(env_, state_.llh, llh_rate_old, v_old, s.v_eb_n,
-                            2.0 * L_mid - state_.llh.lat_rad, dt_s_);
-  return s;
-}
-
 void NedMechanization::Update(const ImuIncrement& increment) {
+  // The step is the lockstep kernel's, at one lane (lockstep_ned_kernel.h: Kernel<1>::NedStep,
+  // which documents the algorithm): the same code for one run here and for W runs at once.
+  NedStepJob job;
+  job.dt_s = dt_s_;
+  job.coning_sculling = options_.coning_sculling ? 1 : 0;
+  if (env_.model() == EarthModel::kFlat) {
+    // The flat environment's constants, read through its accessors (any latitude gives them).
+    job.earth.flat = 1;
+    job.earth.flat_R_N_m = env_.MeridianRadiusAt(0.0);
+    job.earth.flat_R_E_m = env_.TransverseRadiusAt(0.0);
+    job.earth.flat_gravity_m_per_s2 = env_.Gravity(0.0, 0.0).z();
+  }
   const Vector3d& dtheta = increment.delta_theta_ib_b;
   const Vector3d& dv = increment.delta_v_ib_b;
-
-  // Body attitude increment and specific-force increment in the body frame at t_k.
-  //   alpha = dtheta_k + 1/12 dtheta_{k-1} x dtheta_k                     (two-sample coning)
-  //   dv_b = dv_k + 1/2 dtheta_k x dv_k + 1/12 (dtheta_{k-1} x dv_k + dv_{k-1} x dtheta_k)
-  //                                      (rotation compensation + two-sample sculling)
-  // Savage (1998) part 1 (eqs. 15, 28), part 2 (eqs. 19, 20); Groves (5.97)-(5.98). Both are exact
-  // for angular rate and specific force linear in time (to first order in the rotation; the
-  // second-order term follows in Propagate). On the first step no previous increment
-  // exists; the constant-rate assumption (previous = current) makes the 1/12 terms vanish.
-  Vector3d alpha = dtheta;
-  Vector3d delta_v_b = dv;
-  Vector3d alpha_cross_dv = Vector3d::Zero();
-  Vector3d second_order_b = Vector3d::Zero();
-  if (options_.coning_sculling) {
-    alpha_cross_dv = dtheta.cross(dv);
-    // Second-order rotation compensation 1/6 alpha x (alpha x dv) (exact integral of
-    // exp([omega t x]) f for constant omega and f, Savage (1998) part 2).
-    second_order_b = dtheta.cross(alpha_cross_dv) / 6.0;
-    delta_v_b += 0.5 * alpha_cross_dv;
-    if (have_previous_) {
-      alpha += previous_.delta_theta_ib_b.cross(dtheta) / 12.0;
-      delta_v_b +=
-          (previous_.delta_theta_ib_b.cross(dv) + previous_.delta_v_ib_b.cross(dtheta)) / 12.0;
-    }
-  }
-
-  // Predictor: midpoint velocity extrapolated from the last two epochs, midpoint position by half
-  // an Euler step with it.
-  const Vector3d v_mid_predicted =
-      have_previous_ ? Vector3d(1.5 * state_.v_eb_n - 0.5 * previous_v_eb_n_) : state_.v_eb_n;
-  const Vector3d llh_rate_old = env_.LlhRate(state_.llh.lat_rad, state_.llh.h_m, state_.v_eb_n);
-  const Vector3d llh_rate_mid = env_.LlhRate(state_.llh.lat_rad, state_.llh.h_m, v_mid_predicted);
-  const Step predicted =
-      Propagate(delta_v_b, alpha_cross_dv, second_order_b, llh_rate_old,
-                state_.llh.lat_rad + 0.5 * dt_s_ * llh_rate_mid.x(),
-                state_.llh.h_m + 0.5 * dt_s_ * llh_rate_mid.z(), v_mid_predicted);
-  // Corrector: midpoint quantities as averages of the old and the predicted new state.
-  const Step corrected = Propagate(delta_v_b, alpha_cross_dv, second_order_b, llh_rate_old,
-                                   0.5 * (state_.llh.lat_rad + predicted.llh.lat_rad),
-                                   0.5 * (state_.llh.h_m + predicted.llh.h_m),
-                                   0.5 * (state_.v_eb_n + predicted.v_eb_n));
-
-  // Attitude: C_b_n(k+1) = C_n(k)_n(k+1) C_b_n(k) C_b(k+1)_b(k), each factor the exact rotation of
-  // its rotation vector:  q_b_n(k+1) = q(-zeta) q_b_n(k) q(alpha).                Groves (5.75)
-  state_.q_b_n = (RotationVectorToQuaternion(-corrected.zeta) * state_.q_b_n *
-                  RotationVectorToQuaternion(alpha))
-                     .normalized();
-  previous_v_eb_n_ = state_.v_eb_n;
+  const Vector3d& previous_dtheta = previous_.delta_theta_ib_b;
+  const Vector3d& previous_dv = previous_.delta_v_ib_b;
+  const Quaterniond& q = state_.q_b_n;
+  NedStepState s{state_.llh.lat_rad,
+                 state_.llh.lon_rad,
+                 state_.llh.h_m,
+                 {state_.v_eb_n.x(), state_.v_eb_n.y(), state_.v_eb_n.z()},
+                 {q.w(), q.x(), q.y(), q.z()},
+                 {previous_dtheta.x(), previous_dtheta.y(), previous_dtheta.z()},
+                 {previous_dv.x(), previous_dv.y(), previous_dv.z()},
+                 {previous_v_eb_n_.x(), previous_v_eb_n_.y(), previous_v_eb_n_.z()},
+                 have_previous_ ? 1 : 0};
+  Kernel1::NedStep(job, s, {dtheta.x(), dtheta.y(), dtheta.z()}, {dv.x(), dv.y(), dv.z()});
+  state_.q_b_n = Quaterniond(s.q_b_n[0], s.q_b_n[1], s.q_b_n[2], s.q_b_n[3]);
+  previous_v_eb_n_ = Vector3d(s.previous_v_eb_n[0], s.previous_v_eb_n[1], s.previous_v_eb_n[2]);
   previous_ = increment;
   have_previous_ = true;
   ++steps_;
   state_.t_s = t0_s_ + static_cast<double>(steps_) * dt_s_;
-  state_.llh = corrected.llh;
-  state_.v_eb_n = corrected.v_eb_n;
+  state_.llh.lat_rad = s.lat_rad;
+  state_.llh.lon_rad = s.lon_rad;
+  state_.llh.h_m = s.h_m;
+  state_.v_eb_n = Vector3d(s.v_eb_n[0], s.v_eb_n[1], s.v_eb_n[2]);
 }
 
 // ---- Mechanization B -----------------------------------------------------------------------

@@ -51,6 +51,36 @@ template <int W>
 inline U<W> GreaterMask(U<W> a, U<W> b) {
   return U<W>{} - ((b - a) >> 63);
 }
+// Lane i of a mask (W = 1: the value itself).
+template <int W>
+inline uint64_t GetLane(U<W> v, int i) {
+  if constexpr (W == 1) {
+    (void)i;
+    return v;
+  } else {
+    return v[i];
+  }
+}
+// x clamped to [lo, hi] lane by lane (lo <= hi; a NaN lane stays NaN).
+template <int W>
+inline D<W> Clamp(D<W> x, double lo, double hi) {
+  if constexpr (W == 1) {
+    return x < lo ? lo : (hi < x ? hi : x);
+  } else {
+    for (int i = 0; i < W; ++i) x[i] = x[i] < lo ? lo : (hi < x[i] ? hi : x[i]);
+    return x;
+  }
+}
+// floor, lane by lane.
+template <int W>
+inline D<W> Floor(D<W> x) {
+  if constexpr (W == 1) {
+    return __builtin_floor(x);
+  } else {
+    for (int i = 0; i < W; ++i) x[i] = __builtin_floor(x[i]);
+    return x;
+  }
+}
 template <int W>
 inline D<W> Splat(double x) {
   if constexpr (W == 1) {

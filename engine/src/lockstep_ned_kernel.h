@@ -2,17 +2,20 @@
 // W and compiled once per instruction set (lockstep_ned_{baseline,avx2,avx512}.cc include this
 // file). Everything here has internal linkage and uses no Eigen or standard-library templates:
 // each kernel file keeps its own copy, compiled for its instruction set only.
+// At W = 1 (plain double) it is also the scalar code, so each step exists once:
+// NedMechanization::Update (ins.cc) is NedStep at one lane, TriadErrorSimulator::ApplyIncrement
+// (sensors.cc) is TriadStep at one lane; both files include this header (internal linkage, their
+// own compile options).
 //
 // The arithmetic is lane-wise IEEE (GCC vector extensions: +, -, *, / and sqrt are correctly
-// rounded per lane whatever the vector width) with -ffp-contract=off, and each expression is the
-// scalar code's, operation for operation and in the same order:
-//  * sensor error step: TriadErrorSimulator::Apply<true> (sensors.cc);
-//  * mechanization: NedMechanization::Update and Propagate (ins.cc) with NavEnvironment
-//    (earth.cc) and RotationVectorToQuaternion (attitude.cc); Eigen 3.4's order of operations for
-//    its small fixed-size expressions: Matrix3d * Vector3d as Dot3 below, squaredNorm of a
-//    3-vector as x0 + (x1 + x2) (its unrolled reduction halves the range), the quaternion product
-//    as its SSE2/NEON kernel (Geometry_SIMD.h), q * v as _transformVector, normalized() as division
-//    by sqrt of (x^2 + z^2) + (y^2 + w^2) (two-lane packets).
+// rounded per lane whatever the vector width) with -ffp-contract=off. The order of operations is
+// that of the Eigen code the scalar steps were before they ran this kernel (kept so that results
+// did not change), with NavEnvironment (earth.cc) and RotationVectorToQuaternion (attitude.cc):
+// Eigen 3.4's order of operations for its small fixed-size expressions: Matrix3d * Vector3d as
+// Dot3 below, squaredNorm of a 3-vector as x0 + (x1 + x2) (its unrolled reduction halves the
+// range), the quaternion product as its SSE2/NEON kernel (Geometry_SIMD.h), q * v as
+// _transformVector, normalized() as division by sqrt of (x^2 + z^2) + (y^2 + w^2) (two-lane
+// packets).
 // sin and cos are the engine's own (lane_math.h, also used by the scalar earth.cc and attitude.cc),
 // computed for all W lanes at once; tan L is sin L / cos L in both.
 #pragma once
@@ -25,7 +28,6 @@
 
 namespace driftlab::lockstep {
 namespace {
-
 
 template <int W>
 struct Kernel {
@@ -64,7 +66,30 @@ struct Kernel {
     return s;
   }
   // All-ones lanes where the comparison holds.
-  static U Mask(decltype(P{} < P{}) m) { return __builtin_bit_cast(U, m); }
+  static U Mask(decltype(P{} < P{}) m) {
+    if constexpr (W == 1) {
+      return m ? ~uint64_t{0} : uint64_t{0};
+    } else {
+      return __builtin_bit_cast(U, m);
+    }
+  }
+
+  // State fields of W lanes (x[lane] arrays of the lane structs, lockstep_lanes.h) or, for W = 1,
+  // plain doubles (the scalar code's state): read and written alike.
+  static P Get(const double (&a)[kMaxLanes]) { return Load(a); }
+  static P Get(const double& x) requires(W == 1) { return x; }
+  static void Put(double (&a)[kMaxLanes], P v) { Store(a, v); }
+  static void Put(double& x, P v) requires(W == 1) { x = v; }
+  template <typename A>
+  static V3 Get3(const A& a) {
+    return {Get(a[0]), Get(a[1]), Get(a[2])};
+  }
+  template <typename A>
+  static void Put3(A& a, const V3& v) {
+    Put(a[0], v.x);
+    Put(a[1], v.y);
+    Put(a[2], v.z);
+  }
 
   static V3 Add(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
   static V3 Sub(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
@@ -98,10 +123,9 @@ struct Kernel {
     const P n2 = (q.x * q.x + q.z * q.z) + (q.y * q.y + q.w * q.w);
     const P n = Sqrt(n2);
     const U positive = Mask(n2 > 0.0);
-    return {lane_math::Select<W>(positive, q.w / n, q.w),
-            lane_math::Select<W>(positive, q.x / n, q.x),
-            lane_math::Select<W>(positive, q.y / n, q.y),
-            lane_math::Select<W>(positive, q.z / n, q.z)};
+    return {
+        lane_math::Select<W>(positive, q.w / n, q.w), lane_math::Select<W>(positive, q.x / n, q.x),
+        lane_math::Select<W>(positive, q.y / n, q.y), lane_math::Select<W>(positive, q.z / n, q.z)};
   }
   // RotationVectorToQuaternion (attitude.cc): both of its branches for every lane, then the one
   // each lane's angle takes.
@@ -112,7 +136,7 @@ struct Kernel {
     // The Earth-rate rotation (~1e-6 rad a step) and a slowly turning body take the series in
     // every lane: sin and cos are then skipped (their lanes would not be selected).
     bool any_large = false;
-    for (int i = 0; i < W; ++i) any_large = any_large || small[i] == 0;
+    for (int i = 0; i < W; ++i) any_large = any_large || lane_math::GetLane<W>(small, i) == 0;
     P sin_half = Splat(0.0), cos_half = Splat(1.0);
     if (any_large) lane_math::SinCos<W>(0.5 * a, sin_half, cos_half);
     const P w = lane_math::Select<W>(small, 1.0 - a2 / 8.0 + a2 * a2 / 384.0, cos_half);
@@ -185,45 +209,46 @@ struct Kernel {
     return row < 2 ? (a0 + a1) + a2 : a0 + (a1 + a2);
   }
 
-  // ---- Sensor error step (TriadErrorSimulator::Apply<true>)
-  // -------------------------------------- `ideal` and `additive` are the same for every lane (the
-  // shared truth); the result per lane.
-  static V3 TriadStep(const TriadParams& p, TriadLanes& t, const double ideal[3],
-                      const double additive[3], uint64_t k, int j_block, uint64_t block_begin,
-                      double dt) {
+  // ---- Sensor error step (TriadErrorSimulator::ApplyIncrement runs it at W = 1) ---------------
+  // `p` has TriadParams's fields, `t` TriadLanes's run-state fields (lane arrays, or plain doubles
+  // for W = 1: sensors.cc), `dev` the step's deviates (White(i), GmW1(i), GmW2(i), RwW1(i),
+  // RwW2(i), and Flicker(i, j, k, m) for component j of period 2^m at step k). `ideal` and
+  // `additive` are the same for every lane (the shared truth); the result per lane.
+  template <typename Params, typename State, typename Deviates>
+  static V3 TriadStep(const Params& p, State& t, const Deviates& dev, const double ideal[3],
+                      const double additive[3], uint64_t k, double dt) {
     double out[3][W];
     const double weight = dt;
     for (int i = 0; i < 3; ++i) {
-      const P m0 = Load(t.scale_misalignment[i][0]);
-      const P m1 = Load(t.scale_misalignment[i][1]);
-      const P m2 = Load(t.scale_misalignment[i][2]);
+      const P m0 = Get(t.scale_misalignment[i][0]);
+      const P m1 = Get(t.scale_misalignment[i][1]);
+      const P m2 = Get(t.scale_misalignment[i][2]);
       P y = Dot3(i, m0 * ideal[0], m1 * ideal[1], m2 * ideal[2]) + additive[i];
       if (p.asymmetry) y = y + p.half_asymmetry[i] * __builtin_fabs(ideal[i]);
-      P e = Load(t.constant_bias[i]) * weight;
-      if (p.white) e = e + p.white_increment * Load(t.white[i][j_block]);
+      P e = Get(t.constant_bias[i]) * weight;
+      if (p.white) e = e + p.white_increment * dev.White(i);
       if (p.gauss_markov) {
-        const P w1 = Load(t.gm_w1[i][j_block]);
-        const P b = Load(t.gm_state[i]);
-        e = e + (p.gm_mean_gain * b + p.gm_integral_w1_gain * w1 +
-                 p.gm_integral_w2_gain * Load(t.gm_w2[i][j_block]));
-        Store(t.gm_state[i], p.gm_decay * b + p.gm_drive_sigma * w1);
+        const P w1 = dev.GmW1(i);
+        const P b = Get(t.gm_state[i]);
+        e = e +
+            (p.gm_mean_gain * b + p.gm_integral_w1_gain * w1 + p.gm_integral_w2_gain * dev.GmW2(i));
+        Put(t.gm_state[i], p.gm_decay * b + p.gm_drive_sigma * w1);
       }
       if (p.random_walk) {
-        const P step = p.rw_step_sigma * Load(t.rw_w1[i][j_block]);
-        const P b = Load(t.rw_state[i]);
-        e = e + (b * dt + 0.5 * dt * step + p.rw_bridge_sigma * Load(t.rw_w2[i][j_block]));
-        Store(t.rw_state[i], b + step);
+        const P step = p.rw_step_sigma * dev.RwW1(i);
+        const P b = Get(t.rw_state[i]);
+        e = e + (b * dt + 0.5 * dt * step + p.rw_bridge_sigma * dev.RwW2(i));
+        Put(t.rw_state[i], b + step);
       }
       if (p.n_flicker > 0) {
         P sum = Splat(0.0);
         for (int j = 0; j < p.n_flicker; ++j) {
           const int m = p.flicker_period_log2[j];
           const uint64_t mask = (uint64_t{1} << m) - 1;
-          P x = Load(t.flicker_state[i][j]);
+          P x = Get(t.flicker_state[i][j]);
           if (k != 0 && (k & mask) == 0) {
-            x = p.flicker_decay[j] * x +
-                p.flicker_drive_sigma[j] * Load(t.flicker_w[i][j][(k - block_begin) >> m]);
-            Store(t.flicker_state[i][j], x);
+            x = p.flicker_decay[j] * x + p.flicker_drive_sigma[j] * dev.Flicker(i, j, k, m);
+            Put(t.flicker_state[i][j], x);
           }
           sum = sum + x;
         }
@@ -232,15 +257,14 @@ struct Kernel {
       P v = y + e;
       if (p.range > 0.0) {
         const double lo = -p.range * weight, hi = p.range * weight;
-        for (int l = 0; l < W; ++l) v[l] = v[l] < lo ? lo : (hi < v[l] ? hi : v[l]);
+        v = lane_math::Clamp<W>(v, lo, hi);
       }
       if (p.quantization > 0.0) {
         const double lsb = p.quantization;
-        const P carried = v + Load(t.remainder[i]);
-        P q = carried / lsb + 0.5;
-        for (int l = 0; l < W; ++l) q[l] = __builtin_floor(q[l]);
+        const P carried = v + Get(t.remainder[i]);
+        const P q = lane_math::Floor<W>(carried / lsb + 0.5);
         const P o = lsb * q;
-        Store(t.remainder[i], carried - o);
+        Put(t.remainder[i], carried - o);
         v = o;
       }
       Store(out[i], v);
@@ -248,14 +272,15 @@ struct Kernel {
     return {Load(out[0]), Load(out[1]), Load(out[2])};
   }
 
-  // ---- Mechanization (NedMechanization::Update / Propagate)
+  // ---- Mechanization (NedMechanization::Update runs it at W = 1)
   // ---------------------------------------
   struct Step {
     P L, lon, h;
     V3 v, zeta;
   };
 
-  static Step Propagate(const KernelJob& job, const Q4& q, const P& L, const P& lon, const P& h,
+  template <typename Job>
+  static Step Propagate(const Job& job, const Q4& q, const P& L, const P& lon, const P& h,
                         const V3& v_old, const V3& delta_v_b, const V3& alpha_cross_dv,
                         const V3& second_order_b, const V3& llh_rate_old, const P& L_mid,
                         const P& h_mid, const V3& v_mid) {
@@ -263,19 +288,44 @@ struct Kernel {
     const EarthParams& e = job.earth;
     const Lat lat_mid = LatOf(L_mid);
     Step s;
+    // Navigation-frame rotation over the interval, rotation rate taken at the midpoint:
+    //   zeta = (omega_ie_n + omega_en_n)(mid) dt                               Groves (5.73)-(5.76)
     const V3 omega_ie_n = EarthRate(e, lat_mid);
     const V3 omega_en_n = TransportRate(e, lat_mid, h_mid, v_mid);
     s.zeta = Scale(Add(omega_ie_n, omega_en_n), dt);
     const V3& zeta = s.zeta;
+    // Specific-force velocity increment resolved in n, delta_v_sf_n = integral of
+    // C_n(k)^n(t) C_b_n(k) C_b(t)^b(k) f_ib_b dt, expanded to second order in the body rotation
+    // alpha and the n-frame rotation zeta (rates constant over the interval; the linear variation
+    // is the sculling term already in delta_v_b):
+    //   integral = x + 1/2 w + 1/6 C alpha x (alpha x dv) - 1/2 zeta x x - 1/3 zeta x w
+    //              + 1/6 zeta x (zeta x x),        x = C_b_n(k) dv, w = C_b_n(k) (alpha x dv)
+    // (the -1/3 from integrating s^2 over the cross term of the two rotations). With
+    // u = x + 1/2 w = C_b_n(k) delta_v_b (delta_v_b holding dv + 1/2 alpha x dv + sculling):
+    //   delta_v_sf_n = u + 1/6 C alpha x (alpha x dv) - 1/2 zeta x u - 1/12 zeta x w
+    //                  + 1/6 zeta x (zeta x u)               + O(3rd order)
+    // Savage (1998) part 2 section 3 (the first-order form is his eq. 24).
+    // The second-order terms matter: at 10 Hz a stationary body otherwise drifts by
+    // 1/4 zeta x (zeta x g dt) ~ 1e-11 m/s per step, and in a 0.5 rad/s turn 1/6 alpha^2 dv reaches
+    // 2e-7 m/s per step at 100 Hz.
     const V3 u = Rotate(q, delta_v_b);
     const V3 delta_v_sf_n =
         Add(Sub(Sub(Add(u, Rotate(q, second_order_b)), Scale(0.5, Cross(zeta, u))),
                 Div(Cross(zeta, Rotate(q, alpha_cross_dv)), 12.0)),
             Div(Cross(zeta, Cross(zeta, u)), 6.0));
+    // Gravity and Coriolis at the midpoint:
+    //   v(k+1) = v(k) + delta_v_sf_n + (g_b_n - (omega_en_n + 2 omega_ie_n) x v_eb_n)(mid) dt
+    //                                                                                 Groves (5.54)
     const V3 g_b_n = Gravity(e, lat_mid, h_mid);
     s.v = Add(Add(v_old, delta_v_sf_n),
               Scale(Sub(g_b_n, Cross(Add(omega_en_n, Scale(2.0, omega_ie_n)), v_mid)), dt));
-    // TrapezoidPosition (ins.cc).
+    // Position by the trapezoidal rule on (L, lambda, h), Groves (5.56)-style: the rate of
+    // (L, lambda, h) with the old velocity at the old position (llh_rate_old) and with the new
+    // velocity at the new position. The new latitude inside the second evaluation only scales
+    // R_N, R_E and cos L, so a predicted value (error O(dt^2)) is enough: it enters the step at
+    // O(dt^3 v / R^2).
+    // 2 L_mid - L_k is the midpoint-rule prediction of L_k+1 (exactly the predicted L_k+1 in the
+    // corrector, whose L_mid is the average of the two).
     const P L_new_predicted = 2.0 * L_mid - L;
     const P h_new = h - 0.5 * dt * (v_old.z + s.v.z);
     const V3 rate_new = LlhRate(e, LatOf(L_new_predicted), h_new, s.v);
@@ -285,16 +335,29 @@ struct Kernel {
     return s;
   }
 
-  static void NedStep(const KernelJob& job, NavLanes& n, const V3& dtheta, const V3& dv) {
+  // `job` has dt_s, earth and coning_sculling (KernelJob, or NedStepJob in ins.cc); `n` the fields
+  // of NavLanes (lane arrays, or plain doubles for W = 1: NedMechanization's state, ins.cc).
+  template <typename Job, typename Nav>
+  static void NedStep(const Job& job, Nav& n, const V3& dtheta, const V3& dv) {
     const double dt = job.dt_s;
+    // Body attitude increment and specific-force increment in the body frame at t_k.
+    //   alpha = dtheta_k + 1/12 dtheta_{k-1} x dtheta_k                     (two-sample coning)
+    //   dv_b = dv_k + 1/2 dtheta_k x dv_k + 1/12 (dtheta_{k-1} x dv_k + dv_{k-1} x dtheta_k)
+    //                                      (rotation compensation + two-sample sculling)
+    // Savage (1998) part 1 (eqs. 15, 28), part 2 (eqs. 19, 20); Groves (5.97)-(5.98). Both are
+    // exact for angular rate and specific force linear in time (to first order in the rotation; the
+    // second-order term follows in Propagate). On the first step no previous increment
+    // exists; the constant-rate assumption (previous = current) makes the 1/12 terms vanish.
     V3 alpha = dtheta;
     V3 delta_v_b = dv;
     V3 alpha_cross_dv = Splat3(0.0, 0.0, 0.0);
     V3 second_order_b = Splat3(0.0, 0.0, 0.0);
-    const V3 previous_dtheta = Load3(n.previous_dtheta);
-    const V3 previous_dv = Load3(n.previous_dv);
+    const V3 previous_dtheta = Get3(n.previous_dtheta);
+    const V3 previous_dv = Get3(n.previous_dv);
     if (job.coning_sculling) {
       alpha_cross_dv = Cross(dtheta, dv);
+      // Second-order rotation compensation 1/6 alpha x (alpha x dv) (exact integral of
+      // exp([omega t x]) f for constant omega and f, Savage (1998) part 2).
       second_order_b = Div(Cross(dtheta, alpha_cross_dv), 6.0);
       delta_v_b = Add(delta_v_b, Scale(0.5, alpha_cross_dv));
       if (n.have_previous) {
@@ -303,10 +366,12 @@ struct Kernel {
             Add(delta_v_b, Div(Add(Cross(previous_dtheta, dv), Cross(previous_dv, dtheta)), 12.0));
       }
     }
-    const P L = Load(n.lat_rad), lon = Load(n.lon_rad), h = Load(n.h_m);
-    const V3 v = Load3(n.v_eb_n);
-    const V3 previous_v = Load3(n.previous_v_eb_n);
-    const Q4 q{Load(n.q_b_n[0]), Load(n.q_b_n[1]), Load(n.q_b_n[2]), Load(n.q_b_n[3])};
+    const P L = Get(n.lat_rad), lon = Get(n.lon_rad), h = Get(n.h_m);
+    const V3 v = Get3(n.v_eb_n);
+    const V3 previous_v = Get3(n.previous_v_eb_n);
+    const Q4 q{Get(n.q_b_n[0]), Get(n.q_b_n[1]), Get(n.q_b_n[2]), Get(n.q_b_n[3])};
+    // Predictor: midpoint velocity extrapolated from the last two epochs, midpoint position by half
+    // an Euler step with it.
     const V3 v_mid_predicted = n.have_previous ? Sub(Scale(1.5, v), Scale(0.5, previous_v)) : v;
     const Lat lat = LatOf(L);
     const V3 llh_rate_old = LlhRate(job.earth, lat, h, v);
@@ -314,24 +379,43 @@ struct Kernel {
     const Step predicted =
         Propagate(job, q, L, lon, h, v, delta_v_b, alpha_cross_dv, second_order_b, llh_rate_old,
                   L + 0.5 * dt * llh_rate_mid.x, h + 0.5 * dt * llh_rate_mid.z, v_mid_predicted);
+    // Corrector: midpoint quantities as averages of the old and the predicted new state.
     const Step corrected = Propagate(job, q, L, lon, h, v, delta_v_b, alpha_cross_dv,
                                      second_order_b, llh_rate_old, 0.5 * (L + predicted.L),
                                      0.5 * (h + predicted.h), Scale(0.5, Add(v, predicted.v)));
+    // Attitude: C_b_n(k+1) = C_n(k)_n(k+1) C_b_n(k) C_b(k+1)_b(k), each factor the exact rotation
+    // of its rotation vector:  q_b_n(k+1) = q(-zeta) q_b_n(k) q(alpha).                Groves
+    // (5.75)
     const V3 minus_zeta{-corrected.zeta.x, -corrected.zeta.y, -corrected.zeta.z};
     const Q4 q_new = Normalized(
         Mul(Mul(RotationVectorToQuaternion(minus_zeta), q), RotationVectorToQuaternion(alpha)));
-    Store(n.q_b_n[0], q_new.w);
-    Store(n.q_b_n[1], q_new.x);
-    Store(n.q_b_n[2], q_new.y);
-    Store(n.q_b_n[3], q_new.z);
-    Store3(n.previous_v_eb_n, v);
-    Store3(n.previous_dtheta, dtheta);
-    Store3(n.previous_dv, dv);
-    Store(n.lat_rad, corrected.L);
-    Store(n.lon_rad, corrected.lon);
-    Store(n.h_m, corrected.h);
-    Store3(n.v_eb_n, corrected.v);
+    Put(n.q_b_n[0], q_new.w);
+    Put(n.q_b_n[1], q_new.x);
+    Put(n.q_b_n[2], q_new.y);
+    Put(n.q_b_n[3], q_new.z);
+    Put3(n.previous_v_eb_n, v);
+    Put3(n.previous_dtheta, dtheta);
+    Put3(n.previous_dv, dv);
+    Put(n.lat_rad, corrected.L);
+    Put(n.lon_rad, corrected.lon);
+    Put(n.h_m, corrected.h);
+    Put3(n.v_eb_n, corrected.v);
   }
+
+  // The deviates of one step of a lane group: [axis][j][lane] of the block's buffers (TriadLanes).
+  struct LaneDeviates {
+    const TriadLanes& t;
+    int j;                 // step - block_begin
+    uint64_t block_begin;  // first step of the block
+    P White(int i) const { return Load(t.white[i][j]); }
+    P GmW1(int i) const { return Load(t.gm_w1[i][j]); }
+    P GmW2(int i) const { return Load(t.gm_w2[i][j]); }
+    P RwW1(int i) const { return Load(t.rw_w1[i][j]); }
+    P RwW2(int i) const { return Load(t.rw_w2[i][j]); }
+    P Flicker(int i, int c, uint64_t k, int m) const {
+      return Load(t.flicker_w[i][c][(k - block_begin) >> m]);
+    }
+  };
 
   // Sample k (increment over (t_{k-1}, t_k]) is the sensor's step d = k - 1 (its deviate index,
   // TriadErrorSimulator::step()); the block holds the deviates of steps [block_begin, +kBlock).
@@ -353,9 +437,10 @@ struct Kernel {
           }
         }
         const double zero[3] = {0.0, 0.0, 0.0};
-        dtheta =
-            TriadStep(job.triad[0], group->triad[0], ideal, g_term, d, j, block_begin, job.dt_s);
-        dv = TriadStep(job.triad[1], group->triad[1], ideal + 3, zero, d, j, block_begin, job.dt_s);
+        const LaneDeviates gyro{group->triad[0], j, block_begin};
+        const LaneDeviates accel{group->triad[1], j, block_begin};
+        dtheta = TriadStep(job.triad[0], group->triad[0], gyro, ideal, g_term, d, job.dt_s);
+        dv = TriadStep(job.triad[1], group->triad[1], accel, ideal + 3, zero, d, job.dt_s);
       } else {
         dtheta = Splat3(ideal[0], ideal[1], ideal[2]);
         dv = Splat3(ideal[3], ideal[4], ideal[5]);

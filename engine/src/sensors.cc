@@ -11,6 +11,10 @@
 #include <numbers>
 
 #include "driftlab/spec_error.h"
+// The lane kernel has internal linkage (its own anonymous namespace): this file's Kernel<1> is
+// compiled with this file's options only and shares no inline code with the kernel files built
+// for other instruction sets.
+#include "lockstep_ned_kernel.h"
 
 namespace driftlab {
 namespace {
@@ -346,7 +350,7 @@ TriadErrorSimulator::TriadErrorSimulator(const TriadErrorParams& params, SensorI
     gm_d_ = job.gm_integral_w2_gain;
     gm_ch_ = add_channels(ErrorTerm::kGaussMarkov, 1);
     gm_int_ch_ = add_channels(ErrorTerm::kGaussMarkovIntegral, 1);
-    gm_state_ = run.gm_state;
+    for (int i = 0; i < 3; ++i) state_.gm_state[i] = run.gm_state[i];
   }
   if (job.random_walk) {
     rw_step_ = job.rw_step_sigma;
@@ -360,50 +364,95 @@ TriadErrorSimulator::TriadErrorSimulator(const TriadErrorParams& params, SensorI
     flicker_a_ = job.flicker_decay;
     flicker_drive_ = job.flicker_drive_sigma;
     flicker_period_log2_ = job.flicker_period_log2;
-    flicker_state_ = run.flicker_state;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < n_flicker_; ++j) state_.flicker_state[i][j] = run.flicker_state[i][j];
+    }
     flicker_ch_ = add_channels(ErrorTerm::kFlicker, n_flicker_);
   }
   range_ = job.range;
   quantization_ = job.quantization;
+
+  StepParams& p = step_params_;
+  p.asymmetry = has_asymmetry_ ? 1 : 0;
+  for (int i = 0; i < 3; ++i) {
+    p.half_asymmetry[i] = half_asymmetry_[i];
+    state_.constant_bias[i] = constant_bias_[i];
+    for (int c = 0; c < 3; ++c) state_.scale_misalignment[i][c] = scale_misalignment_(i, c);
+  }
+  p.white = white_ch_ >= 0 ? 1 : 0;
+  p.white_increment = white_increment_;
+  p.gauss_markov = gm_ch_ >= 0 ? 1 : 0;
+  p.gm_decay = gm_a_;
+  p.gm_drive_sigma = gm_drive_;
+  p.gm_mean_gain = gm_mean_gain_;
+  p.gm_integral_w1_gain = gm_c_;
+  p.gm_integral_w2_gain = gm_d_;
+  p.random_walk = rw_ch_ >= 0 ? 1 : 0;
+  p.rw_step_sigma = rw_step_;
+  p.rw_bridge_sigma = rw_bridge_;
+  p.n_flicker = n_flicker_;
+  for (int j = 0; j < n_flicker_; ++j) {
+    p.flicker_decay[j] = flicker_a_[j];
+    p.flicker_drive_sigma[j] = flicker_drive_[j];
+    p.flicker_period_log2[j] = flicker_period_log2_[j];
+  }
+  p.range = range_;
+  p.quantization = quantization_;
 }
 
-template <bool kIncrement>
-Eigen::Vector3d TriadErrorSimulator::Apply(const Eigen::Vector3d& ideal,
-                                           const Eigen::Vector3d& additive) {
+Eigen::Vector3d TriadErrorSimulator::ApplyIncrement(const Eigen::Vector3d& ideal,
+                                                    const Eigen::Vector3d& additive) {
   const double dt = dt_s_;
-  const double weight = kIncrement ? dt : 1.0;  // constant rate -> increment or sample
+  const uint64_t k = static_cast<uint64_t>(step_);
+  // The lockstep kernel's step at one lane, its deviates from this run's channels.
+  struct Deviates {
+    TriadErrorSimulator* s;
+    uint64_t k;
+    double At(int first, int axis) const { return s->channels_[first + axis].At(k); }
+    double White(int i) const { return At(s->white_ch_, i); }
+    double GmW1(int i) const { return At(s->gm_ch_, i); }
+    double GmW2(int i) const { return At(s->gm_int_ch_, i); }
+    double RwW1(int i) const { return At(s->rw_ch_, i); }
+    double RwW2(int i) const { return At(s->rw_int_ch_, i); }
+    double Flicker(int i, int j, uint64_t step, int m) const {
+      return s->channels_[s->flicker_ch_ + i * s->n_flicker_ + j].At((step >> m) - 1);
+    }
+  };
+  const Deviates dev{this, k};
+  const auto out = lockstep::Kernel<1>::TriadStep(step_params_, state_, dev, ideal.data(),
+                                                  additive.data(), k, dt);
+  ++step_;
+  return Eigen::Vector3d(out.x, out.y, out.z);
+}
+
+// A point sample: the increment step's terms as rates (weight 1 instead of dt), the Gauss-Markov
+// and random-walk states as they are at the instant, white noise N / sqrt(dt), the quantization
+// LSB divided by dt.
+Eigen::Vector3d TriadErrorSimulator::ApplySample(const Eigen::Vector3d& ideal,
+                                                 const Eigen::Vector3d& additive) {
+  const double dt = dt_s_;
   const uint64_t k = static_cast<uint64_t>(step_);
   Eigen::Vector3d y = scale_misalignment_ * ideal + additive;
   if (has_asymmetry_) y += half_asymmetry_.cwiseProduct(ideal.cwiseAbs());  // sign(x) a/2 x
   for (int i = 0; i < 3; ++i) {
-    double e = constant_bias_[i] * weight;
-    if (white_ch_ >= 0) {
-      e += (kIncrement ? white_increment_ : white_sample_) * channels_[white_ch_ + i].At(k);
-    }
+    double e = constant_bias_[i];
+    if (white_ch_ >= 0) e += white_sample_ * channels_[white_ch_ + i].At(k);
     if (gm_ch_ >= 0) {
       const double w1 = channels_[gm_ch_ + i].At(k);
-      double& b = gm_state_[i];
-      if constexpr (kIncrement) {
-        e += gm_mean_gain_ * b + gm_c_ * w1 + gm_d_ * channels_[gm_int_ch_ + i].At(k);
-      } else {
-        e += b;
-      }
+      double& b = state_.gm_state[i];
+      e += b;
       b = gm_a_ * b + gm_drive_ * w1;
     }
     if (rw_ch_ >= 0) {
       const double step = rw_step_ * channels_[rw_ch_ + i].At(k);
-      double& b = rw_state_[i];
-      if constexpr (kIncrement) {
-        e += b * dt + 0.5 * dt * step + rw_bridge_ * channels_[rw_int_ch_ + i].At(k);
-      } else {
-        e += b;
-      }
+      double& b = state_.rw_state[i];
+      e += b;
       b += step;
     }
     if (n_flicker_ > 0) {
       double sum = 0.0;
       Channel* ch = &channels_[flicker_ch_ + i * n_flicker_];
-      std::array<double, kMaxFlickerComponents>& x = flicker_state_[i];
+      double* x = state_.flicker_state[i];
       for (int j = 0; j < n_flicker_; ++j) {
         const int m = flicker_period_log2_[j];
         const uint64_t mask = (uint64_t{1} << m) - 1;
@@ -412,31 +461,21 @@ Eigen::Vector3d TriadErrorSimulator::Apply(const Eigen::Vector3d& ideal,
         }
         sum += x[j];
       }
-      e += sum * weight;
+      e += sum;
     }
     double v = y[i] + e;
-    if (range_ > 0.0) v = std::clamp(v, -range_ * weight, range_ * weight);
+    if (range_ > 0.0) v = std::clamp(v, -range_, range_);
     if (quantization_ > 0.0) {
-      const double lsb = kIncrement ? quantization_ : quantization_ / dt;
-      const double carried = v + remainder_[i];
+      const double lsb = quantization_ / dt;
+      const double carried = v + state_.remainder[i];
       const double out = lsb * std::floor(carried / lsb + 0.5);
-      remainder_[i] = carried - out;
+      state_.remainder[i] = carried - out;
       v = out;
     }
     y[i] = v;
   }
   ++step_;
   return y;
-}
-
-Eigen::Vector3d TriadErrorSimulator::ApplyIncrement(const Eigen::Vector3d& ideal_increment,
-                                                    const Eigen::Vector3d& additive_increment) {
-  return Apply<true>(ideal_increment, additive_increment);
-}
-
-Eigen::Vector3d TriadErrorSimulator::ApplySample(const Eigen::Vector3d& ideal,
-                                                 const Eigen::Vector3d& additive) {
-  return Apply<false>(ideal, additive);
 }
 
 namespace {

@@ -51,17 +51,6 @@ class NedMechanization {
   const NedMechanizationOptions& options() const { return options_; }
 
  private:
-  // Position and velocity after one step, computed from the current state with the given
-  // midpoint values, and the n-frame rotation vector zeta of the step.
-  struct Step {
-    Llh llh;
-    Vector3d v_eb_n;
-    Vector3d zeta;
-  };
-  Step Propagate(const Vector3d& delta_v_b, const Vector3d& alpha_cross_dv,
-                 const Vector3d& second_order_b, const Vector3d& llh_rate_old, double L_mid,
-                 double h_mid, const Vector3d& v_mid) const;
-
   NavEnvironment env_;
   NavState state_;
   double dt_s_;

@@ -183,8 +183,6 @@ class TriadErrorSimulator {
     void Refill(uint64_t index);
   };
 
-  template <bool kIncrement>
-  Eigen::Vector3d Apply(const Eigen::Vector3d& ideal, const Eigen::Vector3d& additive);
   Channel& ChannelAt(int first, int axis) { return channels_[first + axis]; }
 
   double dt_s_ = 0.0;
@@ -216,11 +214,32 @@ class TriadErrorSimulator {
   int white_ch_ = -1, gm_ch_ = -1, gm_int_ch_ = -1, rw_ch_ = -1, rw_int_ch_ = -1, flicker_ch_ = -1;
   std::vector<Channel> channels_;
 
-  // Per-axis state.
-  std::array<double, 3> gm_state_{};
-  std::array<double, 3> rw_state_{};
-  std::array<std::array<double, kMaxFlickerComponents>, 3> flicker_state_{};
-  std::array<double, 3> remainder_{};
+  // The increment step is the lockstep kernel's at one lane (Kernel<1>::TriadStep in
+  // engine/src/lockstep_ned_kernel.h); these are its job constants and run state, with the field
+  // names of lockstep::TriadParams and TriadLanes (one double per lane).
+  struct StepParams {
+    int white = 0, gauss_markov = 0, random_walk = 0, asymmetry = 0, n_flicker = 0;
+    double white_increment = 0.0;
+    double gm_decay = 0.0, gm_drive_sigma = 0.0, gm_mean_gain = 0.0;
+    double gm_integral_w1_gain = 0.0, gm_integral_w2_gain = 0.0;
+    double rw_step_sigma = 0.0, rw_bridge_sigma = 0.0;
+    double half_asymmetry[3] = {0.0, 0.0, 0.0};
+    double flicker_decay[kMaxFlickerComponents] = {};
+    double flicker_drive_sigma[kMaxFlickerComponents] = {};
+    int flicker_period_log2[kMaxFlickerComponents] = {};
+    double range = 0.0, quantization = 0.0;
+  };
+  struct StepState {
+    double scale_misalignment[3][3] = {};  // [row][column]
+    double constant_bias[3] = {};
+    // Per-axis state.
+    double gm_state[3] = {};
+    double rw_state[3] = {};
+    double remainder[3] = {};
+    double flicker_state[3][kMaxFlickerComponents] = {};
+  };
+  StepParams step_params_;
+  StepState state_;
 };
 
 // The error simulator of a full IMU (gyro and accelerometer triads) for one run at one output
