@@ -6,6 +6,8 @@
 
 #include <cstdint>
 
+#include "driftlab/triad_step_params.h"
+
 namespace driftlab::lockstep {
 
 inline constexpr int kMaxLanes = 8;
@@ -13,21 +15,10 @@ inline constexpr int kMaxLanes = 8;
 // 128 rather than 32 lets the deviate loops run 32 Philox blocks per call (AVX-512 white+GM+RW:
 // 3.4 -> 4.5 M samples/s/core measured).
 inline constexpr int kBlock = 128;
-inline constexpr int kMaxFlicker = 24;  // kMaxFlickerComponents (sensors.h)
+inline constexpr int kMaxFlicker = kTriadStepMaxFlicker;  // kMaxFlickerComponents (sensors.h)
 
-// Job constants of one triad (TriadJobConstants, flattened for the kernel).
-struct TriadParams {
-  int white = 0, gauss_markov = 0, random_walk = 0, asymmetry = 0, n_flicker = 0;
-  double white_increment = 0.0;
-  double gm_decay = 0.0, gm_drive_sigma = 0.0, gm_mean_gain = 0.0;
-  double gm_integral_w1_gain = 0.0, gm_integral_w2_gain = 0.0;
-  double rw_step_sigma = 0.0, rw_bridge_sigma = 0.0;
-  double half_asymmetry[3] = {0.0, 0.0, 0.0};
-  double flicker_decay[kMaxFlicker] = {};
-  double flicker_drive_sigma[kMaxFlicker] = {};
-  int flicker_period_log2[kMaxFlicker] = {};
-  double range = 0.0, quantization = 0.0;
-};
+// Job constants of one triad (TriadJobConstants, flattened for the kernel; TriadStepParamsOf).
+using TriadParams = ::driftlab::TriadStepParams;
 
 // Earth model constants of the job (NavEnvironment without the per-call branch on its kind).
 struct EarthParams {

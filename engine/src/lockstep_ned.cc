@@ -10,32 +10,6 @@
 namespace driftlab::lockstep {
 namespace {
 
-TriadParams FlatTriad(const TriadJobConstants& c) {
-  TriadParams p;
-  p.white = c.white_noise;
-  p.white_increment = c.white_increment;
-  p.gauss_markov = c.gauss_markov;
-  p.gm_decay = c.gm_decay;
-  p.gm_drive_sigma = c.gm_drive_sigma;
-  p.gm_mean_gain = c.gm_mean_gain;
-  p.gm_integral_w1_gain = c.gm_integral_w1_gain;
-  p.gm_integral_w2_gain = c.gm_integral_w2_gain;
-  p.random_walk = c.random_walk;
-  p.rw_step_sigma = c.rw_step_sigma;
-  p.rw_bridge_sigma = c.rw_bridge_sigma;
-  p.asymmetry = c.has_asymmetry;
-  for (int i = 0; i < 3; ++i) p.half_asymmetry[i] = c.half_asymmetry[i];
-  p.n_flicker = static_cast<int>(c.flicker.size());
-  for (int j = 0; j < p.n_flicker; ++j) {
-    p.flicker_decay[j] = c.flicker_decay[static_cast<size_t>(j)];
-    p.flicker_drive_sigma[j] = c.flicker_drive_sigma[static_cast<size_t>(j)];
-    p.flicker_period_log2[j] = c.flicker_period_log2[static_cast<size_t>(j)];
-  }
-  p.range = c.range;
-  p.quantization = c.quantization;
-  return p;
-}
-
 constexpr ErrorTerm kPerSampleTerms[5] = {ErrorTerm::kWhiteNoise, ErrorTerm::kGaussMarkov,
                                           ErrorTerm::kGaussMarkovIntegral, ErrorTerm::kRandomWalk,
                                           ErrorTerm::kRandomWalkIntegral};
@@ -90,7 +64,7 @@ LockstepJob ComposeJob(const ImuErrorModel* model, uint64_t seed, const NavEnvir
     k.has_sensor = 1;
     job.constants[0] = ComposeTriadJobConstants(model->gyro, rate_hz, "sensor.gyro");
     job.constants[1] = ComposeTriadJobConstants(model->accel, rate_hz, "sensor.accel");
-    for (int t = 0; t < 2; ++t) k.triad[t] = FlatTriad(job.constants[t]);
+    for (int t = 0; t < 2; ++t) k.triad[t] = TriadStepParamsOf(job.constants[t]);
     k.g_sensitivity = !model->gyro_g_sensitivity.isZero(0.0);
     for (int r = 0; r < 3; ++r) {
       for (int c = 0; c < 3; ++c) k.gyro_g_sensitivity[r][c] = model->gyro_g_sensitivity(r, c);

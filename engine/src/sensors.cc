@@ -315,6 +315,32 @@ TriadRunConstants DrawTriadRunConstants(const TriadErrorParams& params,
   return run;
 }
 
+TriadStepParams TriadStepParamsOf(const TriadJobConstants& c) {
+  TriadStepParams p;
+  p.white = c.white_noise;
+  p.white_increment = c.white_increment;
+  p.gauss_markov = c.gauss_markov;
+  p.gm_decay = c.gm_decay;
+  p.gm_drive_sigma = c.gm_drive_sigma;
+  p.gm_mean_gain = c.gm_mean_gain;
+  p.gm_integral_w1_gain = c.gm_integral_w1_gain;
+  p.gm_integral_w2_gain = c.gm_integral_w2_gain;
+  p.random_walk = c.random_walk;
+  p.rw_step_sigma = c.rw_step_sigma;
+  p.rw_bridge_sigma = c.rw_bridge_sigma;
+  p.asymmetry = c.has_asymmetry;
+  for (int i = 0; i < 3; ++i) p.half_asymmetry[i] = c.half_asymmetry[i];
+  p.n_flicker = static_cast<int>(c.flicker.size());
+  for (int j = 0; j < p.n_flicker; ++j) {
+    p.flicker_decay[j] = c.flicker_decay[static_cast<size_t>(j)];
+    p.flicker_drive_sigma[j] = c.flicker_drive_sigma[static_cast<size_t>(j)];
+    p.flicker_period_log2[j] = c.flicker_period_log2[static_cast<size_t>(j)];
+  }
+  p.range = c.range;
+  p.quantization = c.quantization;
+  return p;
+}
+
 TriadErrorSimulator::TriadErrorSimulator(const TriadErrorParams& params, SensorId sensor,
                                          uint64_t seed, uint32_t run_index, double rate_hz,
                                          const std::string& path) {
@@ -372,32 +398,11 @@ TriadErrorSimulator::TriadErrorSimulator(const TriadErrorParams& params, SensorI
   range_ = job.range;
   quantization_ = job.quantization;
 
-  StepParams& p = step_params_;
-  p.asymmetry = has_asymmetry_ ? 1 : 0;
+  step_params_ = TriadStepParamsOf(job);
   for (int i = 0; i < 3; ++i) {
-    p.half_asymmetry[i] = half_asymmetry_[i];
     state_.constant_bias[i] = constant_bias_[i];
     for (int c = 0; c < 3; ++c) state_.scale_misalignment[i][c] = scale_misalignment_(i, c);
   }
-  p.white = white_ch_ >= 0 ? 1 : 0;
-  p.white_increment = white_increment_;
-  p.gauss_markov = gm_ch_ >= 0 ? 1 : 0;
-  p.gm_decay = gm_a_;
-  p.gm_drive_sigma = gm_drive_;
-  p.gm_mean_gain = gm_mean_gain_;
-  p.gm_integral_w1_gain = gm_c_;
-  p.gm_integral_w2_gain = gm_d_;
-  p.random_walk = rw_ch_ >= 0 ? 1 : 0;
-  p.rw_step_sigma = rw_step_;
-  p.rw_bridge_sigma = rw_bridge_;
-  p.n_flicker = n_flicker_;
-  for (int j = 0; j < n_flicker_; ++j) {
-    p.flicker_decay[j] = flicker_a_[j];
-    p.flicker_drive_sigma[j] = flicker_drive_[j];
-    p.flicker_period_log2[j] = flicker_period_log2_[j];
-  }
-  p.range = range_;
-  p.quantization = quantization_;
 }
 
 Eigen::Vector3d TriadErrorSimulator::ApplyIncrement(const Eigen::Vector3d& ideal,

@@ -45,6 +45,7 @@
 #include "driftlab/nav_state.h"
 #include "driftlab/random.h"
 #include "driftlab/sensor_params.h"
+#include "driftlab/triad_step_params.h"
 
 namespace driftlab {
 
@@ -130,6 +131,9 @@ struct TriadJobConstants {
 // Validates `params` (field path `path`) and rate_hz, then composes the job constants.
 TriadJobConstants ComposeTriadJobConstants(const TriadErrorParams& params, double rate_hz,
                                            const std::string& path = "sensor");
+// The job constants flattened for the lane kernel's error step (terms that are off: flag 0).
+TriadStepParams TriadStepParamsOf(const TriadJobConstants& job);
+static_assert(kTriadStepMaxFlicker == kMaxFlickerComponents);
 
 // The constants of one triad in one run, drawn from the run's streams: I + S + M (without
 // asymmetry), b_fixed + b_turn_on, and the start states of the Gauss-Markov and flicker terms.
@@ -215,20 +219,8 @@ class TriadErrorSimulator {
   std::vector<Channel> channels_;
 
   // The increment step is the lockstep kernel's at one lane (Kernel<1>::TriadStep in
-  // engine/src/lockstep_ned_kernel.h); these are its job constants and run state, with the field
-  // names of lockstep::TriadParams and TriadLanes (one double per lane).
-  struct StepParams {
-    int white = 0, gauss_markov = 0, random_walk = 0, asymmetry = 0, n_flicker = 0;
-    double white_increment = 0.0;
-    double gm_decay = 0.0, gm_drive_sigma = 0.0, gm_mean_gain = 0.0;
-    double gm_integral_w1_gain = 0.0, gm_integral_w2_gain = 0.0;
-    double rw_step_sigma = 0.0, rw_bridge_sigma = 0.0;
-    double half_asymmetry[3] = {0.0, 0.0, 0.0};
-    double flicker_decay[kMaxFlickerComponents] = {};
-    double flicker_drive_sigma[kMaxFlickerComponents] = {};
-    int flicker_period_log2[kMaxFlickerComponents] = {};
-    double range = 0.0, quantization = 0.0;
-  };
+  // engine/src/lockstep_ned_kernel.h); these are its job constants (the lockstep runs' struct)
+  // and run state, with the field names of lockstep::TriadLanes (one double per lane).
   struct StepState {
     double scale_misalignment[3][3] = {};  // [row][column]
     double constant_bias[3] = {};
@@ -238,7 +230,7 @@ class TriadErrorSimulator {
     double remainder[3] = {};
     double flicker_state[3][kMaxFlickerComponents] = {};
   };
-  StepParams step_params_;
+  TriadStepParams step_params_;
   StepState state_;
 };
 
