@@ -223,25 +223,41 @@ TEST(ErrorStateModel, FittedFlickerStatesReproduceTheFlickerFloorOverTheRunsTime
             DesignFlickerApproximation(f).size());
 }
 
+// The 55-state model of the structured-step tests: the tactical preset with 3 flicker states per
+// axis and the GNSS position and barometer Gauss-Markov states, along the car drive at 50 Hz; P0
+// the initial errors plus random correlations.
+struct StructuredCase {
+  Trajectory t;
+  ErrorStateNoise noise;
+  ErrorStateMatrix P0;
+};
+StructuredCase MakeStructuredCase() {
+  StructuredCase c;
+  c.t = GenerateTrajectory(CarMotion(), 50.0);
+  ErrorModelOptions three;
+  three.flicker_states_per_axis = 3;
+  c.noise = MakeErrorStateNoise(FindImuPreset("tactical"), "sensor", three).noise;
+  c.noise.gnss_position_gm_sigma_ned_m = Vector3d(0.5, 0.5, 1.0);
+  c.noise.gnss_position_gm_tau_s = 100.0;
+  c.noise.barometer_bias_sigma_m = 2.0;
+  c.noise.barometer_bias_tau_s = 300.0;
+  const int n = ErrorStateLayout(c.noise).size;
+  Eigen::MatrixXd A = Eigen::MatrixXd::Random(n, n) * 1e-3;
+  c.P0 = A * A.transpose() + InitialErrorCovariance(Vector3d(1, 1, 2), Vector3d(0.1, 0.1, 0.1),
+                                                    Vector3d(1e-3, 1e-3, 5e-3),
+                                                    c.t.truth[0].euler(), c.noise);
+  return c;
+}
+
 TEST(ErrorStateModel, StructuredPropagationEqualsTheDenseSecondOrderStep) {
   // The structured step (covariance.h) is the dense second-order Phi P Phi^T + Q_d rearranged:
   // equal to rounding (1e-12 relative, 51 states, sums of a few hundred products).
-  MotionSpec m = CarMotion();
-  const Trajectory t = GenerateTrajectory(m, 50.0);
-  ErrorModelOptions three;
-  three.flicker_states_per_axis = 3;
-  ErrorStateNoise noise = MakeErrorStateNoise(FindImuPreset("tactical"), "sensor", three).noise;
-  noise.gnss_position_gm_sigma_ned_m = Vector3d(0.5, 0.5, 1.0);
-  noise.gnss_position_gm_tau_s = 100.0;
-  noise.barometer_bias_sigma_m = 2.0;
-  noise.barometer_bias_tau_s = 300.0;
+  const StructuredCase c = MakeStructuredCase();
+  const Trajectory& t = c.t;
+  const ErrorStateNoise& noise = c.noise;
+  const ErrorStateMatrix& P0 = c.P0;
   const ErrorStateLayout layout(noise);
   ASSERT_EQ(layout.size, 55);
-  Eigen::MatrixXd A = Eigen::MatrixXd::Random(layout.size, layout.size) * 1e-3;
-  const ErrorStateMatrix P0 =
-      A * A.transpose() + InitialErrorCovariance(Vector3d(1, 1, 2), Vector3d(0.1, 0.1, 0.1),
-                                                 Vector3d(1e-3, 1e-3, 5e-3), t.truth[0].euler(),
-                                                 noise);
   ErrorCovariancePropagator prop(t.environment, noise, P0, Discretization::kSecondOrder);
   const size_t k = 400;
   const Vector3d f_b = t.increments[k].delta_v_ib_b / t.dt_s;
@@ -263,22 +279,12 @@ TEST(ErrorStateModel, StructuredExactStepEqualsVanLoansDenseExponential) {
   // is the rounding of the dense exponential (Pade with scaling and squaring: relative error
   // ~ N u ||F dt|| ~ 1e-13 here, Higham 2005): 1e-11 relative leaves a factor 100. Steps of
   // 0.02 s (one sample), 0.2 s and 1 s, the last with the turn's largest rates.
-  MotionSpec m = CarMotion();
-  const Trajectory t = GenerateTrajectory(m, 50.0);
-  ErrorModelOptions three;
-  three.flicker_states_per_axis = 3;
-  ErrorStateNoise noise = MakeErrorStateNoise(FindImuPreset("tactical"), "sensor", three).noise;
-  noise.gnss_position_gm_sigma_ned_m = Vector3d(0.5, 0.5, 1.0);
-  noise.gnss_position_gm_tau_s = 100.0;
-  noise.barometer_bias_sigma_m = 2.0;
-  noise.barometer_bias_tau_s = 300.0;
+  const StructuredCase c = MakeStructuredCase();
+  const Trajectory& t = c.t;
+  const ErrorStateNoise& noise = c.noise;
+  const ErrorStateMatrix& P0 = c.P0;
   const ErrorStateLayout layout(noise);
   ASSERT_EQ(layout.size, 55);
-  Eigen::MatrixXd A = Eigen::MatrixXd::Random(layout.size, layout.size) * 1e-3;
-  const ErrorStateMatrix P0 =
-      A * A.transpose() + InitialErrorCovariance(Vector3d(1, 1, 2), Vector3d(0.1, 0.1, 0.1),
-                                                 Vector3d(1e-3, 1e-3, 5e-3), t.truth[0].euler(),
-                                                 noise);
   for (const auto& [k, dt] : {std::pair<size_t, double>{400, 0.02}, {400, 0.2}, {1500, 1.0}}) {
     ErrorCovariancePropagator prop(t.environment, noise, P0, Discretization::kVanLoan);
     const Vector3d f_b = t.increments[k].delta_v_ib_b / t.dt_s;
