@@ -18,6 +18,7 @@
 
 #include "driftlab/presets.h"
 #include "driftlab/trajectory.h"
+#include "car_like_motion.h"
 #include "lockstep_ned.h"
 
 namespace driftlab {
@@ -26,23 +27,7 @@ namespace {
 constexpr double kRate_hz = 100.0;
 
 const Trajectory& Drive() {
-  static const Trajectory t = [] {
-    constexpr double kDeg = M_PI / 180.0;
-    MotionSpec m;
-    m.initial.llh = {45.0 * kDeg, 7.0 * kDeg, 300.0};
-    m.segments.push_back(StaticSegment{60.0});
-    AccelerateSegment acc;
-    acc.acceleration_m_per_s2 = 1.0;
-    acc.target_speed_m_per_s = 20.0;
-    m.segments.push_back(acc);
-    TurnSegment turn;
-    turn.rate_rad_per_s = 3.0 * kDeg;
-    turn.angle_rad = 90.0 * kDeg;
-    turn.transition_s = 2.0;
-    m.segments.push_back(turn);
-    m.segments.push_back(ConstantVelocitySegment{600.0 - 60.0 - 20.0 - 32.0});
-    return GenerateTrajectory(m, kRate_hz);
-  }();
+  static const Trajectory t = GenerateTrajectory(bench::CarLike600s(), kRate_hz);
   return t;
 }
 

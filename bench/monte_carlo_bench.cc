@@ -13,26 +13,15 @@
 
 #include "driftlab/monte_carlo.h"
 #include "driftlab/presets.h"
+#include "car_like_motion.h"
 
 namespace driftlab {
 namespace {
 
 // 600 s at 100 Hz: 60 s static, accelerate to 20 m/s, a 90-degree turn, cruise.
 MonteCarloSpec BenchJob(int threads, uint32_t runs) {
-  constexpr double kDeg = M_PI / 180.0;
   MonteCarloSpec spec;
-  spec.simulation.motion.initial.llh = {45.0 * kDeg, 7.0 * kDeg, 300.0};
-  spec.simulation.motion.segments.push_back(StaticSegment{60.0});
-  AccelerateSegment acc;
-  acc.acceleration_m_per_s2 = 1.0;
-  acc.target_speed_m_per_s = 20.0;
-  spec.simulation.motion.segments.push_back(acc);
-  TurnSegment turn;
-  turn.rate_rad_per_s = 3.0 * kDeg;
-  turn.angle_rad = 90.0 * kDeg;
-  turn.transition_s = 2.0;
-  spec.simulation.motion.segments.push_back(turn);
-  spec.simulation.motion.segments.push_back(ConstantVelocitySegment{600.0 - 60.0 - 20.0 - 32.0});
+  spec.simulation.motion = bench::CarLike600s();
   spec.simulation.rate_hz = 100.0;
   spec.sensor = FindImuPreset("tactical");
   spec.runs = runs;
