@@ -13,31 +13,18 @@
 #include "driftlab/monte_carlo.h"
 #include "driftlab/presets.h"
 #include "driftlab/simulate.h"
+#include "support/small_monte_carlo_job.h"
 
 namespace driftlab {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-// 20 s static, 10 s accelerating at 1 m/s^2 northward, 30 s constant velocity, at 20 Hz; the
-// tactical preset, 4 runs, initial errors, checkpoints at 25 s, 40 s and the end.
+// testing::SmallMonteCarloJob with 4 runs, seed 7 and checkpoints at 25 s, 40 s and the end.
 MonteCarloSpec SmallJob() {
-  MonteCarloSpec spec;
-  spec.simulation.motion.initial.llh = {45.0 * kDeg, 7.0 * kDeg, 300.0};
-  spec.simulation.motion.segments.push_back(StaticSegment{20.0});
-  AccelerateSegment acc;
-  acc.acceleration_m_per_s2 = 1.0;
-  acc.duration_s = 10.0;
-  spec.simulation.motion.segments.push_back(acc);
-  spec.simulation.motion.segments.push_back(ConstantVelocitySegment{30.0});
-  spec.simulation.rate_hz = 20.0;
-  spec.sensor = FindImuPreset("tactical");
+  MonteCarloSpec spec = testing::SmallMonteCarloJob();
   spec.runs = 4;
   spec.seed = 7;
-  spec.initial_errors.position_ned_m = Vector3d(1.0, 2.0, 3.0);
-  spec.initial_errors.velocity_ned_m_per_s = Vector3d(0.01, 0.02, 0.03);
-  spec.initial_errors.attitude_rad = Vector3d(1e-3, 2e-3, 3e-3);
-  spec.epoch_every_samples = 20;
   spec.checkpoint_times_s = {25.0, 40.0};
   return spec;
 }
