@@ -491,6 +491,45 @@ TEST(SensorNoiseTest, RandomWalkIncrementVarianceIsKSquaredHCubedOverThree) {
   EXPECT_LT(r2, hi);
 }
 
+TEST(SensorNoiseTest, WhiteGaussMarkovAndRandomWalkTogetherKeepEachTermsIncrementStatistics) {
+  // The increment step draws one deviate for the three parts no state carries (white noise, the
+  // GM integral's independent part, the walk's Brownian bridge; sensors.h independent_sigma).
+  // With all three on, each about a third of the variance, the first increment from b_rw = 0
+  // must have the sum of the three variances above, N^2 h + 2 sigma^2 T^2 (x - 1 + e^-x) +
+  // K^2 h^3 / 3, and consecutive increments the sum of the state-carried covariances,
+  // sigma^2 T^2 (1 - e^-x)^2 + K^2 h^3 / 2 (walk: int_0^h int_h^2h min(s, t) dt ds = h^3 / 2),
+  // white noise adding none. A wrong scale or a deviate reused across steps moves one of them by
+  // far more than the bounds (chi-square for the variance; product bound as above).
+  const double rate_hz = 10.0, h = 1.0 / rate_hz;
+  const double sigma = 1e-4, tau_s = 0.1, x = h / tau_s;
+  const double gm_var = 2 * sigma * sigma * tau_s * tau_s * (x - 1 + std::exp(-x));
+  const double N = std::sqrt(gm_var / h);        // white share = gm share
+  const double K = std::sqrt(3.0 * gm_var / (h * h * h));  // walk share = gm share
+  ImuErrorModel model;
+  model.gyro.white_noise_density = N;
+  model.gyro.bias_gauss_markov = {sigma, tau_s};
+  model.gyro.random_walk = K;
+  const int runs = 30'000;
+  long double sum = 0, sum_lag = 0;
+  for (int r = 0; r < runs; ++r) {
+    ImuErrorSimulator sim(model, 17, r, rate_hz);
+    ImuIncrement zero, first, second;
+    sim.Apply(zero, &first);
+    sim.Apply(zero, &second);
+    sum += first.delta_theta_ib_b.squaredNorm();
+    sum_lag += first.delta_theta_ib_b.dot(second.delta_theta_ib_b);
+  }
+  const double n = 3.0 * runs;
+  const double expected = N * N * h + gm_var + K * K * h * h * h / 3.0;
+  const auto [lo, hi] = VarianceRatioBounds(n);
+  EXPECT_GT(static_cast<double>(sum / n) / expected, lo);
+  EXPECT_LT(static_cast<double>(sum / n) / expected, hi);
+  const double expected_cov = sigma * sigma * tau_s * tau_s * std::pow(1 - std::exp(-x), 2) +
+                              K * K * h * h * h / 2.0;
+  EXPECT_NEAR(static_cast<double>(sum_lag / n), expected_cov,
+              kZ * std::sqrt(2.0 / n) * expected);
+}
+
 TEST(SensorNoiseTest, TurnOnBiasAndRandomScaleFactorSpreadAcrossRunsMatchSigma) {
   // One draw per run and axis: 3R samples, chi-square bounds on the mean square.
   ImuErrorModel model;

@@ -48,11 +48,9 @@ struct TriadLanes {
   double flicker_state[3][kMaxFlicker][kMaxLanes];
   // Deviates of the current block: per-sample terms at [axis][k mod kBlock][lane]; flicker
   // component j at [axis][j][(k - block start) >> period_log2[j]][lane].
-  double white[3][kBlock][kMaxLanes];
+  double independent[3][kBlock][kMaxLanes];  // TriadJobConstants::independent_sigma's deviate
   double gm_w1[3][kBlock][kMaxLanes];
-  double gm_w2[3][kBlock][kMaxLanes];
   double rw_w1[3][kBlock][kMaxLanes];
-  double rw_w2[3][kBlock][kMaxLanes];
   double flicker_w[3][kMaxFlicker][kBlock][kMaxLanes];
 };
 

@@ -10,16 +10,14 @@
 namespace driftlab::lockstep {
 namespace {
 
-constexpr ErrorTerm kPerSampleTerms[5] = {ErrorTerm::kWhiteNoise, ErrorTerm::kGaussMarkov,
-                                          ErrorTerm::kGaussMarkovIntegral, ErrorTerm::kRandomWalk,
-                                          ErrorTerm::kRandomWalkIntegral};
+constexpr ErrorTerm kPerSampleTerms[kPerSampleStreams] = {
+    ErrorTerm::kWhiteNoise, ErrorTerm::kGaussMarkov, ErrorTerm::kRandomWalk};
 
 bool TermOn(const TriadParams& p, int term) {
   switch (term) {
     case 0:
-      return p.white != 0;
+      return p.independent != 0;
     case 1:
-    case 2:
       return p.gauss_markov != 0;
     default:
       return p.random_walk != 0;
@@ -29,15 +27,11 @@ bool TermOn(const TriadParams& p, int term) {
 double (*PerSampleBuffer(TriadLanes& t, int term))[kBlock][kMaxLanes] {
   switch (term) {
     case 0:
-      return t.white;
+      return t.independent;
     case 1:
       return t.gm_w1;
-    case 2:
-      return t.gm_w2;
-    case 3:
-      return t.rw_w1;
     default:
-      return t.rw_w2;
+      return t.rw_w1;
   }
 }
 
@@ -98,7 +92,7 @@ void StartSensorLane(const LockstepJob& job, uint32_t run, int lane, LockstepGro
       }
     }
     const TriadParams& p = job.kernel.triad[t];
-    for (int term = 0; term < 5; ++term) {
+    for (int term = 0; term < kPerSampleStreams; ++term) {
       if (!TermOn(p, term)) continue;
       for (int axis = 0; axis < 3; ++axis) {
         streams->per_sample[t][term][axis][lane] = RandomStream(
@@ -146,7 +140,7 @@ void LoadBlock(const LockstepJob& job, const Kernel& kernel, int64_t block_begin
   for (int t = 0; t < 2; ++t) {
     const TriadParams& p = job.kernel.triad[t];
     TriadLanes& lanes = group->triad[t];
-    for (int term = 0; term < 5; ++term) {
+    for (int term = 0; term < kPerSampleStreams; ++term) {
       if (!TermOn(p, term)) continue;
       double(*dst)[kBlock][kMaxLanes] = PerSampleBuffer(lanes, term);
       for (int axis = 0; axis < 3; ++axis) {

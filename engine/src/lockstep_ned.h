@@ -70,10 +70,13 @@ static_assert(kMaxFlicker == kMaxFlickerComponents);
 LockstepJob ComposeJob(const ImuErrorModel* model, uint64_t seed, const NavEnvironment& env,
                        double rate_hz, const NedMechanizationOptions& options);
 
+// Per-sample streams of a triad: the independent part, the GM drive, the walk's step.
+inline constexpr int kPerSampleStreams = 3;
+
 // The random streams of a group's runs (kept between blocks).
 struct GroupStreams {
-  // [triad][term: white, gm_w1, gm_w2, rw_w1, rw_w2][axis][lane]
-  RandomStream per_sample[2][5][3][kMaxLanes];
+  // [triad][stream: independent (kWhiteNoise), gm_w1, rw_w1][axis][lane]
+  RandomStream per_sample[2][kPerSampleStreams][3][kMaxLanes];
   // [triad][axis][component][lane]
   std::vector<RandomStream> flicker;
   RandomStream& Flicker(int triad, int axis, int j, int lane) {

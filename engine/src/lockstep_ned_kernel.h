@@ -211,8 +211,7 @@ struct Kernel {
 
   // ---- Sensor error step (TriadErrorSimulator::ApplyIncrement runs it at W = 1) ---------------
   // `p` has TriadParams's fields, `t` TriadLanes's run-state fields (lane arrays, or plain doubles
-  // for W = 1: sensors.cc), `dev` the step's deviates (White(i), GmW1(i), GmW2(i), RwW1(i),
-  // RwW2(i), and Flicker(i, j, k, m) for component j of period 2^m at step k). `ideal` and
+  // for W = 1: sensors.cc), `dev` the step's deviates (Independent(i), GmW1(i), RwW1(i), and Flicker(i, j, k, m) for component j of period 2^m at step k). `ideal` and
   // `additive` are the same for every lane (the shared truth); the result per lane.
   template <typename Params, typename State, typename Deviates>
   static V3 TriadStep(const Params& p, State& t, const Deviates& dev, const double ideal[3],
@@ -226,18 +225,19 @@ struct Kernel {
       P y = Dot3(i, m0 * ideal[0], m1 * ideal[1], m2 * ideal[2]) + additive[i];
       if (p.asymmetry) y = y + p.half_asymmetry[i] * __builtin_fabs(ideal[i]);
       P e = Get(t.constant_bias[i]) * weight;
-      if (p.white) e = e + p.white_increment * dev.White(i);
+      // White noise, the GM integral's w2 part and the walk's bridge part: one deviate
+      // (TriadJobConstants::independent_sigma, sensors.h).
+      if (p.independent) e = e + p.independent_sigma * dev.Independent(i);
       if (p.gauss_markov) {
         const P w1 = dev.GmW1(i);
         const P b = Get(t.gm_state[i]);
-        e = e +
-            (p.gm_mean_gain * b + p.gm_integral_w1_gain * w1 + p.gm_integral_w2_gain * dev.GmW2(i));
+        e = e + (p.gm_mean_gain * b + p.gm_integral_w1_gain * w1);
         Put(t.gm_state[i], p.gm_decay * b + p.gm_drive_sigma * w1);
       }
       if (p.random_walk) {
         const P step = p.rw_step_sigma * dev.RwW1(i);
         const P b = Get(t.rw_state[i]);
-        e = e + (b * dt + 0.5 * dt * step + p.rw_bridge_sigma * dev.RwW2(i));
+        e = e + (b * dt + 0.5 * dt * step);
         Put(t.rw_state[i], b + step);
       }
       if (p.n_flicker > 0) {
@@ -407,11 +407,9 @@ struct Kernel {
     const TriadLanes& t;
     int j;                 // step - block_begin
     uint64_t block_begin;  // first step of the block
-    P White(int i) const { return Load(t.white[i][j]); }
+    P Independent(int i) const { return Load(t.independent[i][j]); }
     P GmW1(int i) const { return Load(t.gm_w1[i][j]); }
-    P GmW2(int i) const { return Load(t.gm_w2[i][j]); }
     P RwW1(int i) const { return Load(t.rw_w1[i][j]); }
-    P RwW2(int i) const { return Load(t.rw_w2[i][j]); }
     P Flicker(int i, int c, uint64_t k, int m) const {
       return Load(t.flicker_w[i][c][(k - block_begin) >> m]);
     }

@@ -248,6 +248,18 @@ TriadJobConstants ComposeTriadJobConstants(const TriadErrorParams& params, doubl
     job.rw_bridge_sigma = params.random_walk * dt * std::sqrt(dt / 12.0);
   }
 
+  if (job.white_noise || job.gauss_markov || job.random_walk) {
+    // One deviate for the three independent parts (TriadJobConstants::independent_sigma). With
+    // white noise alone the scale is white_increment itself (those jobs keep their numbers).
+    job.independent = true;
+    job.independent_sigma =
+        !job.gauss_markov && !job.random_walk
+            ? job.white_increment
+            : std::sqrt(job.white_increment * job.white_increment +
+                        job.gm_integral_w2_gain * job.gm_integral_w2_gain +
+                        job.rw_bridge_sigma * job.rw_bridge_sigma);
+  }
+
   job.flicker = DesignFlickerApproximation(params.bias_flicker);
   // Component j is advanced exactly every h_j = 2^m dt, the largest such h_j <= tau_j / 32
   // (m = 0 when tau_j < 32 dt), and held between updates. Holding changes the component's
@@ -317,17 +329,15 @@ TriadRunConstants DrawTriadRunConstants(const TriadErrorParams& params,
 
 TriadStepParams TriadStepParamsOf(const TriadJobConstants& c) {
   TriadStepParams p;
-  p.white = c.white_noise;
-  p.white_increment = c.white_increment;
+  p.independent = c.independent;
+  p.independent_sigma = c.independent_sigma;
   p.gauss_markov = c.gauss_markov;
   p.gm_decay = c.gm_decay;
   p.gm_drive_sigma = c.gm_drive_sigma;
   p.gm_mean_gain = c.gm_mean_gain;
   p.gm_integral_w1_gain = c.gm_integral_w1_gain;
-  p.gm_integral_w2_gain = c.gm_integral_w2_gain;
   p.random_walk = c.random_walk;
   p.rw_step_sigma = c.rw_step_sigma;
-  p.rw_bridge_sigma = c.rw_bridge_sigma;
   p.asymmetry = c.has_asymmetry;
   for (int i = 0; i < 3; ++i) p.half_asymmetry[i] = c.half_asymmetry[i];
   p.n_flicker = static_cast<int>(c.flicker.size());
@@ -363,26 +373,18 @@ TriadErrorSimulator::TriadErrorSimulator(const TriadErrorParams& params, SensorI
   constant_bias_ = run.constant_bias;
   half_asymmetry_ = job.half_asymmetry;
   has_asymmetry_ = job.has_asymmetry;
-  if (job.white_noise) {
-    white_increment_ = job.white_increment;
-    white_sample_ = job.white_sample;
-    white_ch_ = add_channels(ErrorTerm::kWhiteNoise, 1);
-  }
+  white_noise_ = job.white_noise;
+  white_sample_ = job.white_sample;
+  if (job.independent) independent_ch_ = add_channels(ErrorTerm::kWhiteNoise, 1);
   if (job.gauss_markov) {
     gm_a_ = job.gm_decay;
     gm_drive_ = job.gm_drive_sigma;
-    gm_mean_gain_ = job.gm_mean_gain;
-    gm_c_ = job.gm_integral_w1_gain;
-    gm_d_ = job.gm_integral_w2_gain;
     gm_ch_ = add_channels(ErrorTerm::kGaussMarkov, 1);
-    gm_int_ch_ = add_channels(ErrorTerm::kGaussMarkovIntegral, 1);
     for (int i = 0; i < 3; ++i) state_.gm_state[i] = run.gm_state[i];
   }
   if (job.random_walk) {
     rw_step_ = job.rw_step_sigma;
-    rw_bridge_ = job.rw_bridge_sigma;
     rw_ch_ = add_channels(ErrorTerm::kRandomWalk, 1);
-    rw_int_ch_ = add_channels(ErrorTerm::kRandomWalkIntegral, 1);
   }
   flicker_ = job.flicker;
   n_flicker_ = static_cast<int>(flicker_.size());
@@ -414,11 +416,9 @@ Eigen::Vector3d TriadErrorSimulator::ApplyIncrement(const Eigen::Vector3d& ideal
     TriadErrorSimulator* s;
     uint64_t k;
     double At(int first, int axis) const { return s->channels_[first + axis].At(k); }
-    double White(int i) const { return At(s->white_ch_, i); }
+    double Independent(int i) const { return At(s->independent_ch_, i); }
     double GmW1(int i) const { return At(s->gm_ch_, i); }
-    double GmW2(int i) const { return At(s->gm_int_ch_, i); }
     double RwW1(int i) const { return At(s->rw_ch_, i); }
-    double RwW2(int i) const { return At(s->rw_int_ch_, i); }
     double Flicker(int i, int j, uint64_t step, int m) const {
       return s->channels_[s->flicker_ch_ + i * s->n_flicker_ + j].At((step >> m) - 1);
     }
@@ -441,7 +441,7 @@ Eigen::Vector3d TriadErrorSimulator::ApplySample(const Eigen::Vector3d& ideal,
   if (has_asymmetry_) y += half_asymmetry_.cwiseProduct(ideal.cwiseAbs());  // sign(x) a/2 x
   for (int i = 0; i < 3; ++i) {
     double e = constant_bias_[i];
-    if (white_ch_ >= 0) e += white_sample_ * channels_[white_ch_ + i].At(k);
+    if (white_noise_) e += white_sample_ * channels_[independent_ch_ + i].At(k);
     if (gm_ch_ >= 0) {
       const double w1 = channels_[gm_ch_ + i].At(k);
       double& b = state_.gm_state[i];

@@ -60,11 +60,15 @@ enum class SensorId : uint8_t {
 // Which error term a stream drives. `component` (StreamKey) distinguishes several streams of one
 // term, e.g. the Gauss-Markov components of the flicker approximation.
 enum class ErrorTerm : uint8_t {
-  kWhiteNoise = 0,           // per sample
+  // Per sample. For an inertial triad's increments: the one deviate of the error's part that no
+  // state carries on (white noise + GM integral's independent part + random walk's bridge part,
+  // TriadJobConstants::independent_sigma, sensors.h); for point samples and aiding sensors: the
+  // white noise.
+  kWhiteNoise = 0,
   kRandomWalk = 1,           // per sample: the walk's step
-  kRandomWalkIntegral = 2,   // per sample: the Brownian-bridge part of the increment integral
+  kRandomWalkIntegral = 2,   // not drawn since issue 17 (folded into kWhiteNoise); reserved
   kGaussMarkov = 3,          // per sample: the process' driving noise
-  kGaussMarkovIntegral = 4,  // per sample: the part of the increment integral independent of it
+  kGaussMarkovIntegral = 4,  // not drawn since issue 17 (folded into kWhiteNoise); reserved
   kFlicker = 5,              // per update of flicker component `component`
   kInitialState = 6,         // stationary initial states (component 0 = GM, 1 + j = flicker j)
   kTurnOnBias = 7,           // per run, index 0

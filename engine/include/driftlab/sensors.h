@@ -118,6 +118,15 @@ struct TriadJobConstants {
   // rw_bridge_sigma w2.
   bool random_walk = false;
   double rw_step_sigma = 0.0, rw_bridge_sigma = 0.0;
+  // The part of an increment's error that no state carries to the next step: the white noise,
+  // the Gauss-Markov integral's w2 part and the random walk's Brownian-bridge w2 part. They are
+  // independent zero-mean Gaussians, so their sum is one Gaussian of the summed variance and
+  // the increment step draws ONE deviate for it (stream kWhiteNoise):
+  //   independent_sigma = sqrt(white_increment^2 + gm_integral_w2_gain^2 + rw_bridge_sigma^2),
+  // exactly white_increment when only white noise is on. Same distribution as three deviates,
+  // 3 instead of 5 deviates per axis for white + GM + random walk.
+  bool independent = false;
+  double independent_sigma = 0.0;
   // Flicker: the design and, per component j, the decay and drive over its update period
   // 2^flicker_period_log2[j] samples.
   std::vector<GaussMarkovComponent> flicker;
@@ -197,13 +206,14 @@ class TriadErrorSimulator {
   bool has_asymmetry_ = false;
   Eigen::Vector3d constant_bias_ = Eigen::Vector3d::Zero();
 
-  // White noise: deviate scale for increments and point samples.
-  double white_increment_ = 0.0;  // N sqrt(dt)
-  double white_sample_ = 0.0;     // N / sqrt(dt)
-  // Gauss-Markov: b' = a b + drive w1; increment integral = mean_gain b + c w1 + d w2.
-  double gm_a_ = 0.0, gm_drive_ = 0.0, gm_mean_gain_ = 0.0, gm_c_ = 0.0, gm_d_ = 0.0;
-  // Random walk: b' = b + step w1; increment integral = b dt + (dt/2) step w1 + bridge w2.
-  double rw_step_ = 0.0, rw_bridge_ = 0.0;
+  // White noise: deviate scale for point samples (N / sqrt(dt); the increment step's scale is
+  // TriadJobConstants::independent_sigma).
+  bool white_noise_ = false;
+  double white_sample_ = 0.0;
+  // Gauss-Markov: b' = a b + drive w1 (point samples; the increment step is the kernel's).
+  double gm_a_ = 0.0, gm_drive_ = 0.0;
+  // Random walk: b' = b + step w1.
+  double rw_step_ = 0.0;
   // Flicker components.
   std::vector<GaussMarkovComponent> flicker_;
   std::array<double, kMaxFlickerComponents> flicker_a_{};
@@ -214,8 +224,9 @@ class TriadErrorSimulator {
   double range_ = 0.0;         // 0 = off
   double quantization_ = 0.0;  // increment LSB; 0 = off
 
-  // Channel index of the first axis of each term; -1 = term off.
-  int white_ch_ = -1, gm_ch_ = -1, gm_int_ch_ = -1, rw_ch_ = -1, rw_int_ch_ = -1, flicker_ch_ = -1;
+  // Channel index of the first axis of each stream; -1 = off. independent_ch_ is the kWhiteNoise
+  // stream: the increments' state-independent deviate, and the white noise of point samples.
+  int independent_ch_ = -1, gm_ch_ = -1, rw_ch_ = -1, flicker_ch_ = -1;
   std::vector<Channel> channels_;
 
   // The increment step is the lockstep kernel's at one lane (Kernel<1>::TriadStep in

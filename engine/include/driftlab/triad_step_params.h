@@ -11,11 +11,11 @@ namespace driftlab {
 inline constexpr int kTriadStepMaxFlicker = 24;  // kMaxFlickerComponents (sensors.h)
 
 struct TriadStepParams {
-  int white = 0, gauss_markov = 0, random_walk = 0, asymmetry = 0, n_flicker = 0;
-  double white_increment = 0.0;
+  int independent = 0, gauss_markov = 0, random_walk = 0, asymmetry = 0, n_flicker = 0;
+  double independent_sigma = 0.0;  // TriadJobConstants::independent_sigma
   double gm_decay = 0.0, gm_drive_sigma = 0.0, gm_mean_gain = 0.0;
-  double gm_integral_w1_gain = 0.0, gm_integral_w2_gain = 0.0;
-  double rw_step_sigma = 0.0, rw_bridge_sigma = 0.0;
+  double gm_integral_w1_gain = 0.0;
+  double rw_step_sigma = 0.0;
   double half_asymmetry[3] = {0.0, 0.0, 0.0};
   double flicker_decay[kTriadStepMaxFlicker] = {};
   double flicker_drive_sigma[kTriadStepMaxFlicker] = {};
