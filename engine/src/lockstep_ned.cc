@@ -74,6 +74,9 @@ void StartSensorLane(const LockstepJob& job, uint32_t run, int lane, LockstepGro
     streams->flicker.resize(static_cast<size_t>(2 * 3 * kMaxFlicker * kMaxLanes));
   }
   for (int t = 0; t < 2; ++t) {
+    for (int j = 0; j < kMaxFlicker; ++j) streams->flicker_window_valid[t][j] = 0;
+  }
+  for (int t = 0; t < 2; ++t) {
     const SensorId sensor = t == 0 ? SensorId::kGyro : SensorId::kAccel;
     const TriadErrorParams& params = t == 0 ? job.model.gyro : job.model.accel;
     const TriadRunConstants rc =
@@ -160,13 +163,33 @@ void LoadBlock(const LockstepJob& job, const Kernel& kernel, int64_t block_begin
       const uint64_t from = first_update == 0 ? period : first_update;
       if (from >= b0 + kBlock) continue;
       const size_t count = static_cast<size_t>((b0 + kBlock - from + period - 1) >> m);
+      // Deviates [first, first + count) of the component's streams, from its window.
+      const uint64_t first = (from >> m) - 1;
+      constexpr int kWindow = GroupStreams::kFlickerWindow;
+      static_assert(kWindow >= kBlock, "a window holds at least one block's deviates");
+      uint64_t& window_first = streams->flicker_window_first[t][j];
+      int& valid = streams->flicker_window_valid[t][j];
+      if (!valid || first < window_first || first + count > window_first + kWindow) {
+        if (streams->flicker_window.empty()) {
+          streams->flicker_window.resize(
+              static_cast<size_t>(2 * kMaxFlicker * 3 * kMaxLanes * kWindow));
+        }
+        for (int axis = 0; axis < 3; ++axis) {
+          for (int lane = 0; lane < group->lanes; ++lane) {
+            const RandomStream& r = streams->Flicker(t, axis, j, lane);
+            kernel.fill(r.key().data(), r.run_word(), r.stream_word(), first,
+                        streams->FlickerWindow(t, j, axis, lane), kWindow);
+          }
+        }
+        window_first = first;
+        valid = 1;
+      }
+      const size_t offset = static_cast<size_t>(first - window_first);
       for (int axis = 0; axis < 3; ++axis) {
         for (int lane = 0; lane < group->lanes; ++lane) {
-          const RandomStream& r = streams->Flicker(t, axis, j, lane);
-          kernel.fill(r.key().data(), r.run_word(), r.stream_word(), (from >> m) - 1, buffer,
-                      static_cast<int>(count));
+          const double* w = streams->FlickerWindow(t, j, axis, lane) + offset;
           for (size_t c = 0; c < count; ++c) {
-            lanes.flicker_w[axis][j][((from - b0) >> m) + c][lane] = buffer[c];
+            lanes.flicker_w[axis][j][((from - b0) >> m) + c][lane] = w[c];
           }
         }
       }

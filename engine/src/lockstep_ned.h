@@ -82,6 +82,20 @@ struct GroupStreams {
   RandomStream& Flicker(int triad, int axis, int j, int lane) {
     return flicker[static_cast<size_t>(((triad * 3 + axis) * kMaxFlicker + j) * kMaxLanes + lane)];
   }
+  // A window of kFlickerWindow deviates per flicker stream, filled in one call and used by the
+  // blocks that need them: a component updated every 2^m samples needs only kBlock >> m deviates
+  // a block, and small fills cost more in call overhead than in arithmetic (tactical preset,
+  // 7 components: ~half its deviate time). Windows of [triad][component] start at the same
+  // deviate index for every axis and lane; StartSensorLane invalidates them (new streams).
+  static constexpr int kFlickerWindow = 128;
+  std::vector<double> flicker_window;  // [triad][component][axis][lane][kFlickerWindow]
+  uint64_t flicker_window_first[2][kMaxFlicker] = {};
+  int flicker_window_valid[2][kMaxFlicker] = {};
+  double* FlickerWindow(int triad, int j, int axis, int lane) {
+    return flicker_window.data() +
+           static_cast<size_t>(((triad * kMaxFlicker + j) * 3 + axis) * kMaxLanes + lane) *
+               kFlickerWindow;
+  }
 };
 
 // Sets lane `lane` of `group` to run `run`: the sensor's run constants and streams; the
