@@ -20,7 +20,10 @@
 // own polynomials (random.cc) so every build, scalar or SIMD, produces the same bits. sqrt is
 // IEEE-754 correctly rounded and therefore identical everywhere. Consequence of 32-bit uniforms:
 // |z| <= sqrt(-2 ln 2^-32) = 6.66, i.e. the tails beyond 6.66 sigma (probability 2.7e-11) are
-// absent; the distribution is otherwise exact to ~1e-15 relative (polynomial truncation).
+// absent, and adjacent inputs give radii >= 3.2e-10 (relative) and angles 1.5e-9 rad apart. The
+// polynomials are summed only as far as that resolution needs (since issue 17; before, to ~1e-18):
+// each deviate is within 2.6e-11 |z| + 7.1e-12 r of the exact transform of its two words
+// (r = sqrt(-2 ln u1)), a twelfth of the input's own step; tests/random_test.cc checks it.
 // Vectorisation: deviates are produced in chunks of 32 Philox blocks (SoA). The Box-Muller code
 // (engine/src/lane_math.h) has no branches, comparisons or conversion instructions, so GCC
 // vectorises it on every x86-64 level (baseline, AVX2, AVX-512: 5.3, 2.9, 1.7 ns per deviate
@@ -116,11 +119,12 @@ class RandomStream {
 
 // The engine's own elementary functions for the Gaussian transform (exposed for tests).
 // Natural logarithm of x in [2^-1022, 2^1024): exponent/mantissa split, then
-// ln m = 2 atanh(s), s = (m - 1)/(m + 1), Taylor series to s^21 (|s| <= 0.172, truncation < 1e-17).
+// ln m = 2 atanh(s), s = (m - 1)/(m + 1), Taylor series to s^11 (|s| <= 0.172: within 5.2e-11
+// relative; engine/src/lane_math.h says why that is enough for 32-bit uniforms).
 double PolyLog(double x);
 // sin(2 pi u) and cos(2 pi u) for u = x 2^-32 in [0, 1): reduced exactly (integer arithmetic) to
-// a quadrant and theta in [-pi/4, pi/4], Taylor series to theta^17 (sin) and theta^16 (cos)
-// (truncation < 1e-19), then rotated by the quadrant.
+// a quadrant and theta in [-pi/4, pi/4], Taylor series to theta^11 (sin) and theta^12 (cos)
+// (within 7.1e-12), then rotated by the quadrant.
 void PolySinCosTwoPi(uint32_t x, double* sin_out, double* cos_out);
 // sin x and cos x as the navigation code computes them (earth.cc, attitude.cc and the lockstep
 // kernels, engine/src/lane_math.h): n = round(2x/pi), t = x - n pi/2 by Cody-Waite with pi/2 in
