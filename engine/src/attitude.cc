@@ -58,8 +58,9 @@ Quaterniond RotationVectorToQuaternion(const Vector3d& rho) {
   const double a = std::sqrt(a2);
   double w, k;  // cos(a/2) and sin(a/2)/a
   if (a < 1e-4) {
-    w = 1.0 - a2 / 8.0 + a2 * a2 / 384.0;
-    k = 0.5 - a2 / 48.0 + a2 * a2 / 3840.0;
+    // Products with the rounded reciprocals, as the lockstep kernel (lockstep_ned_kernel.h).
+    w = 1.0 - a2 * (1.0 / 8.0) + a2 * a2 * (1.0 / 384.0);
+    k = 0.5 - a2 * (1.0 / 48.0) + a2 * a2 * (1.0 / 3840.0);
   } else {
     double sin_half, cos_half;  // the engine's own (lane_math.h), as the lockstep kernels
     lane_math::SinCos<1>(0.5 * a, sin_half, cos_half);

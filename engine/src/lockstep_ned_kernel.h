@@ -96,7 +96,12 @@ struct Kernel {
   static V3 Scale(double s, const V3& a) { return {s * a.x, s * a.y, s * a.z}; }
   static V3 Scale(const V3& a, double s) { return {a.x * s, a.y * s, a.z * s}; }
   static V3 ScaleP(const P& s, const V3& a) { return {s * a.x, s * a.y, s * a.z}; }
-  static V3 Div(const V3& a, double s) { return {a.x / s, a.y / s, a.z / s}; }
+  // The series' constant fractions as products with their rounded reciprocals: a division costs
+  // several times a multiplication, and the rounding of 1/6 and 1/12 (<= 1.1e-16 relative) is far
+  // below these second-order terms' own size. (Until issue 17 they were divisions; the change
+  // moved results in their last bits once, on every path alike.)
+  static constexpr double kOneSixth = 1.0 / 6.0;
+  static constexpr double kOneTwelfth = 1.0 / 12.0;
   // Eigen's cross product of 3-vectors (OrthoMethods.h).
   static V3 Cross(const V3& a, const V3& b) {
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
@@ -139,8 +144,8 @@ struct Kernel {
     for (int i = 0; i < W; ++i) any_large = any_large || lane_math::GetLane<W>(small, i) == 0;
     P sin_half = Splat(0.0), cos_half = Splat(1.0);
     if (any_large) lane_math::SinCos<W>(0.5 * a, sin_half, cos_half);
-    const P w = lane_math::Select<W>(small, 1.0 - a2 / 8.0 + a2 * a2 / 384.0, cos_half);
-    const P k = lane_math::Select<W>(small, 0.5 - a2 / 48.0 + a2 * a2 / 3840.0, sin_half / a);
+    const P w = lane_math::Select<W>(small, 1.0 - a2 * (1.0 / 8.0) + a2 * a2 * (1.0 / 384.0), cos_half);
+    const P k = lane_math::Select<W>(small, 0.5 - a2 * (1.0 / 48.0) + a2 * a2 * (1.0 / 3840.0), sin_half / a);
     return {w, k * rho.x, k * rho.y, k * rho.z};
   }
 
@@ -311,8 +316,8 @@ struct Kernel {
     const V3 u = Rotate(q, delta_v_b);
     const V3 delta_v_sf_n =
         Add(Sub(Sub(Add(u, Rotate(q, second_order_b)), Scale(0.5, Cross(zeta, u))),
-                Div(Cross(zeta, Rotate(q, alpha_cross_dv)), 12.0)),
-            Div(Cross(zeta, Cross(zeta, u)), 6.0));
+                Scale(Cross(zeta, Rotate(q, alpha_cross_dv)), kOneTwelfth)),
+            Scale(Cross(zeta, Cross(zeta, u)), kOneSixth));
     // Gravity and Coriolis at the midpoint:
     //   v(k+1) = v(k) + delta_v_sf_n + (g_b_n - (omega_en_n + 2 omega_ie_n) x v_eb_n)(mid) dt
     //                                                                                 Groves (5.54)
@@ -358,12 +363,12 @@ struct Kernel {
       alpha_cross_dv = Cross(dtheta, dv);
       // Second-order rotation compensation 1/6 alpha x (alpha x dv) (exact integral of
       // exp([omega t x]) f for constant omega and f, Savage (1998) part 2).
-      second_order_b = Div(Cross(dtheta, alpha_cross_dv), 6.0);
+      second_order_b = Scale(Cross(dtheta, alpha_cross_dv), kOneSixth);
       delta_v_b = Add(delta_v_b, Scale(0.5, alpha_cross_dv));
       if (n.have_previous) {
-        alpha = Add(alpha, Div(Cross(previous_dtheta, dtheta), 12.0));
+        alpha = Add(alpha, Scale(Cross(previous_dtheta, dtheta), kOneTwelfth));
         delta_v_b =
-            Add(delta_v_b, Div(Add(Cross(previous_dtheta, dv), Cross(previous_dv, dtheta)), 12.0));
+            Add(delta_v_b, Scale(Add(Cross(previous_dtheta, dv), Cross(previous_dv, dtheta)), kOneTwelfth));
       }
     }
     const P L = Get(n.lat_rad), lon = Get(n.lon_rad), h = Get(n.h_m);
