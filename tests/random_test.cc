@@ -93,9 +93,8 @@ TEST(GaussianTest, DeviatesAreTheBoxMullerTransformOfTheirPhiloxWordsWithinTheSe
   stream.FillGaussian(0, z);
   const long double two_pi = 2.0L * std::numbers::pi_v<long double>;
   for (int b = 0; b < blocks; ++b) {
-    const std::array<uint32_t, 4> x =
-        Philox4x32({static_cast<uint32_t>(b), 0u, stream.run_word(), stream.stream_word()},
-                   stream.key());
+    const std::array<uint32_t, 4> x = Philox4x32(
+        {static_cast<uint32_t>(b), 0u, stream.run_word(), stream.stream_word()}, stream.key());
     for (int pair = 0; pair < 2; ++pair) {
       const long double u1 = (static_cast<long double>(x[2 * pair]) + 1) / 4294967296.0L;
       const long double u2 = static_cast<long double>(x[2 * pair + 1]) / 4294967296.0L;

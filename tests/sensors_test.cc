@@ -503,7 +503,7 @@ TEST(SensorNoiseTest, WhiteGaussMarkovAndRandomWalkTogetherKeepEachTermsIncremen
   const double rate_hz = 10.0, h = 1.0 / rate_hz;
   const double sigma = 1e-4, tau_s = 0.1, x = h / tau_s;
   const double gm_var = 2 * sigma * sigma * tau_s * tau_s * (x - 1 + std::exp(-x));
-  const double N = std::sqrt(gm_var / h);        // white share = gm share
+  const double N = std::sqrt(gm_var / h);                  // white share = gm share
   const double K = std::sqrt(3.0 * gm_var / (h * h * h));  // walk share = gm share
   ImuErrorModel model;
   model.gyro.white_noise_density = N;
@@ -524,10 +524,9 @@ TEST(SensorNoiseTest, WhiteGaussMarkovAndRandomWalkTogetherKeepEachTermsIncremen
   const auto [lo, hi] = VarianceRatioBounds(n);
   EXPECT_GT(static_cast<double>(sum / n) / expected, lo);
   EXPECT_LT(static_cast<double>(sum / n) / expected, hi);
-  const double expected_cov = sigma * sigma * tau_s * tau_s * std::pow(1 - std::exp(-x), 2) +
-                              K * K * h * h * h / 2.0;
-  EXPECT_NEAR(static_cast<double>(sum_lag / n), expected_cov,
-              kZ * std::sqrt(2.0 / n) * expected);
+  const double expected_cov =
+      sigma * sigma * tau_s * tau_s * std::pow(1 - std::exp(-x), 2) + K * K * h * h * h / 2.0;
+  EXPECT_NEAR(static_cast<double>(sum_lag / n), expected_cov, kZ * std::sqrt(2.0 / n) * expected);
 }
 
 TEST(SensorNoiseTest, TurnOnBiasAndRandomScaleFactorSpreadAcrossRunsMatchSigma) {

@@ -252,12 +252,11 @@ TriadJobConstants ComposeTriadJobConstants(const TriadErrorParams& params, doubl
     // One deviate for the three independent parts (TriadJobConstants::independent_sigma). With
     // white noise alone the scale is white_increment itself (those jobs keep their numbers).
     job.independent = true;
-    job.independent_sigma =
-        !job.gauss_markov && !job.random_walk
-            ? job.white_increment
-            : std::sqrt(job.white_increment * job.white_increment +
-                        job.gm_integral_w2_gain * job.gm_integral_w2_gain +
-                        job.rw_bridge_sigma * job.rw_bridge_sigma);
+    job.independent_sigma = !job.gauss_markov && !job.random_walk
+                                ? job.white_increment
+                                : std::sqrt(job.white_increment * job.white_increment +
+                                            job.gm_integral_w2_gain * job.gm_integral_w2_gain +
+                                            job.rw_bridge_sigma * job.rw_bridge_sigma);
   }
 
   job.flicker = DesignFlickerApproximation(params.bias_flicker);
