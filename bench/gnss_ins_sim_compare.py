@@ -44,7 +44,7 @@ def wrap_deg(x):
     return (np.asarray(x) + 180.0) % 360.0 - 180.0
 
 
-def run_gnss_ins_sim(checkout, motion, accuracy, runs, rate_hz):
+def run_gnss_ins_sim(checkout, motion, accuracy, runs, rate_hz, numpy_seed):
     sys.path.insert(0, checkout)
     from gnss_ins_sim.sim import imu_model, ins_sim  # noqa: E402
     from demo_algorithms import free_integration  # noqa: E402
@@ -57,6 +57,9 @@ def run_gnss_ins_sim(checkout, motion, accuracy, runs, rate_hz):
     algo = free_integration.FreeIntegration(ini)
     sim = ins_sim.Sim([rate_hz, 0.0, 0.0], motion, ref_frame=1, imu=imu, mode=None, env=None,
                       algorithm=[algo])
+    # gnss-ins-sim draws its sensor errors from numpy's global generator without seeding it: seed
+    # it here so that a call can be repeated (--numpy-seed).
+    np.random.seed(numpy_seed)
     start, start_cpu = time.perf_counter(), time.process_time()
     sim.run(runs)
     wall_s, cpu_s = time.perf_counter() - start, time.process_time() - start_cpu
@@ -110,11 +113,13 @@ def main():
     p.add_argument("--runs", type=int, default=200)
     p.add_argument("--rate-hz", type=float, default=100.0)
     p.add_argument("--threads", type=int, default=1)
+    p.add_argument("--numpy-seed", type=int, default=17,
+                   help="seed of numpy's global generator, which gnss-ins-sim draws from")
     a = p.parse_args()
     from scipy import stats
 
     errors, gis_samples, gis_wall, gis_cpu = run_gnss_ins_sim(a.gnss_ins_sim, a.motion, a.accuracy,
-                                                     a.runs, a.rate_hz)
+                                                     a.runs, a.rate_hz, a.numpy_seed)
     with tempfile.TemporaryDirectory() as workdir:
         dl_std, dl_samples, dl_wall, dl_cpu = run_driftlab(a.driftlab, a.motion, a.accuracy, a.runs,
                                                    a.rate_hz, a.threads, workdir)
