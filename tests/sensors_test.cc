@@ -433,6 +433,26 @@ TEST(SensorNoiseTest, GaussMarkovStartedAtZeroGrowsAsOneMinusExpMinusTwoTOverTau
   }
 }
 
+// Over `runs` runs of the gyro triad from a zero input: the mean of the first increment's squared
+// components and the mean product of the first and second increments' components (3 per run).
+struct IncrementMoments {
+  double mean_square = 0.0, mean_lag1 = 0.0, n = 0.0;
+};
+IncrementMoments FirstTwoIncrements(const ImuErrorModel& model, uint64_t seed, int runs,
+                                    double rate_hz) {
+  long double sum = 0, sum_lag = 0;
+  for (int r = 0; r < runs; ++r) {
+    ImuErrorSimulator sim(model, seed, r, rate_hz);
+    ImuIncrement zero, first, second;
+    sim.Apply(zero, &first);
+    sim.Apply(zero, &second);
+    sum += first.delta_theta_ib_b.squaredNorm();
+    sum_lag += first.delta_theta_ib_b.dot(second.delta_theta_ib_b);
+  }
+  const double n = 3.0 * runs;
+  return {static_cast<double>(sum / n), static_cast<double>(sum_lag / n), n};
+}
+
 TEST(SensorNoiseTest, GaussMarkovIncrementHasExactIntegralVarianceEvenForDtNearTau) {
   // Stationary OU integrated over h: Var = 2 sigma^2 T^2 (x - 1 + e^-x), x = h / T
   // (Gardiner 3.8.4). At x = 1 this is 0.736 sigma^2 h^2, far from the sigma^2 h^2 of a
@@ -441,26 +461,16 @@ TEST(SensorNoiseTest, GaussMarkovIncrementHasExactIntegralVarianceEvenForDtNearT
   const double sigma = 1e-4, tau_s = 0.1, rate_hz = 10.0, h = 1.0 / rate_hz, x = h / tau_s;
   ImuErrorModel model;
   model.gyro.bias_gauss_markov = {sigma, tau_s};
-  const int runs = 30'000;
-  long double sum = 0, sum_second = 0;
-  for (int r = 0; r < runs; ++r) {
-    ImuErrorSimulator sim(model, 1, r, rate_hz);
-    ImuIncrement zero, first, second;
-    sim.Apply(zero, &first);
-    sim.Apply(zero, &second);
-    sum += first.delta_theta_ib_b.squaredNorm();
-    sum_second += first.delta_theta_ib_b.dot(second.delta_theta_ib_b);
-  }
-  const double n = 3.0 * runs;
+  const IncrementMoments m = FirstTwoIncrements(model, 1, 30'000, rate_hz);
+  const double n = m.n;
   const double expected = 2 * sigma * sigma * tau_s * tau_s * (x - 1 + std::exp(-x));
   const auto [lo, hi] = VarianceRatioBounds(n);
-  EXPECT_GT(static_cast<double>(sum / n) / expected, lo);
-  EXPECT_LT(static_cast<double>(sum / n) / expected, hi);
+  EXPECT_GT(m.mean_square / expected, lo);
+  EXPECT_LT(m.mean_square / expected, hi);
   // Lag-1 covariance of increments: sigma^2 T^2 (1 - e^-x)^2. Var of a product of two correlated
   // Gaussians <= (1 + rho^2) v^2 <= 2 v^2 (v = increment variance): kZ sqrt(2/n) v bound.
   const double expected_cov = sigma * sigma * tau_s * tau_s * std::pow(1 - std::exp(-x), 2);
-  EXPECT_NEAR(static_cast<double>(sum_second / n), expected_cov,
-              kZ * std::sqrt(2.0 / n) * expected);
+  EXPECT_NEAR(m.mean_lag1, expected_cov, kZ * std::sqrt(2.0 / n) * expected);
 }
 
 TEST(SensorNoiseTest, RandomWalkIncrementVarianceIsKSquaredHCubedOverThree) {
@@ -509,24 +519,15 @@ TEST(SensorNoiseTest, WhiteGaussMarkovAndRandomWalkTogetherKeepEachTermsIncremen
   model.gyro.white_noise_density = N;
   model.gyro.bias_gauss_markov = {sigma, tau_s};
   model.gyro.random_walk = K;
-  const int runs = 30'000;
-  long double sum = 0, sum_lag = 0;
-  for (int r = 0; r < runs; ++r) {
-    ImuErrorSimulator sim(model, 17, r, rate_hz);
-    ImuIncrement zero, first, second;
-    sim.Apply(zero, &first);
-    sim.Apply(zero, &second);
-    sum += first.delta_theta_ib_b.squaredNorm();
-    sum_lag += first.delta_theta_ib_b.dot(second.delta_theta_ib_b);
-  }
-  const double n = 3.0 * runs;
+  const IncrementMoments m = FirstTwoIncrements(model, 17, 30'000, rate_hz);
+  const double n = m.n;
   const double expected = N * N * h + gm_var + K * K * h * h * h / 3.0;
   const auto [lo, hi] = VarianceRatioBounds(n);
-  EXPECT_GT(static_cast<double>(sum / n) / expected, lo);
-  EXPECT_LT(static_cast<double>(sum / n) / expected, hi);
+  EXPECT_GT(m.mean_square / expected, lo);
+  EXPECT_LT(m.mean_square / expected, hi);
   const double expected_cov =
       sigma * sigma * tau_s * tau_s * std::pow(1 - std::exp(-x), 2) + K * K * h * h * h / 2.0;
-  EXPECT_NEAR(static_cast<double>(sum_lag / n), expected_cov, kZ * std::sqrt(2.0 / n) * expected);
+  EXPECT_NEAR(m.mean_lag1, expected_cov, kZ * std::sqrt(2.0 / n) * expected);
 }
 
 TEST(SensorNoiseTest, TurnOnBiasAndRandomScaleFactorSpreadAcrossRunsMatchSigma) {
