@@ -15,10 +15,18 @@ Matrix3d Skew(const Vector3d& a) {
   return S;
 }
 
-Matrix3d EulerToDcm(const EulerAngles& e) {
-  const double sp = std::sin(e.roll_rad), cp = std::cos(e.roll_rad);
-  const double st = std::sin(e.pitch_rad), ct = std::cos(e.pitch_rad);
-  const double ss = std::sin(e.yaw_rad), cs = std::cos(e.yaw_rad);
+EulerTrig::EulerTrig(const EulerAngles& e)
+    : sp(std::sin(e.roll_rad)),
+      cp(std::cos(e.roll_rad)),
+      st(std::sin(e.pitch_rad)),
+      ct(std::cos(e.pitch_rad)),
+      ss(std::sin(e.yaw_rad)),
+      cs(std::cos(e.yaw_rad)) {}
+
+Matrix3d EulerToDcm(const EulerAngles& e) { return EulerToDcm(EulerTrig(e)); }
+
+Matrix3d EulerToDcm(const EulerTrig& t) {
+  const double sp = t.sp, cp = t.cp, st = t.st, ct = t.ct, ss = t.ss, cs = t.cs;
   // Transpose of Groves (2.22) (which gives C_n_b).
   Matrix3d C_b_n;
   C_b_n << ct * cs, -cp * ss + sp * st * cs, sp * ss + cp * st * cs,  //
@@ -80,8 +88,11 @@ Vector3d QuaternionToRotationVector(const Quaterniond& q_in) {
 }
 
 Vector3d EulerRatesToBodyRate(const EulerAngles& e, const Vector3d& euler_rates) {
-  const double sp = std::sin(e.roll_rad), cp = std::cos(e.roll_rad);
-  const double st = std::sin(e.pitch_rad), ct = std::cos(e.pitch_rad);
+  return EulerRatesToBodyRate(EulerTrig(e), euler_rates);
+}
+
+Vector3d EulerRatesToBodyRate(const EulerTrig& t, const Vector3d& euler_rates) {
+  const double sp = t.sp, cp = t.cp, st = t.st, ct = t.ct;
   const double droll = euler_rates.x(), dpitch = euler_rates.y(), dyaw = euler_rates.z();
   return Vector3d(droll - dyaw * st, dpitch * cp + dyaw * ct * sp, -dpitch * sp + dyaw * ct * cp);
 }

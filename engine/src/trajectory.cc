@@ -214,8 +214,9 @@ struct BodyPiece {
     k.euler_rates = e1 + 2.0 * s * e2;
     const Vector3d v_b = s <= 0.5 * duration ? Vector3d(b_start + b_slope * s)
                                              : Vector3d(b_end - b_slope * (duration - s));
-    const Matrix3d C_b_n = EulerToDcm(k.euler);
-    const Vector3d omega_nb_b = EulerRatesToBodyRate(k.euler, k.euler_rates);
+    const EulerTrig trig(k.euler);
+    const Matrix3d C_b_n = EulerToDcm(trig);
+    const Vector3d omega_nb_b = EulerRatesToBodyRate(trig, k.euler_rates);
     k.v_eb_n = C_b_n * v_b;
     k.a_eb_n = C_b_n * (b_slope + omega_nb_b.cross(v_b));
     return k;
@@ -1223,12 +1224,12 @@ struct TrajectoryGenerator::Impl {
   }
 
   void PointSample(const Kinematics& k, const Vector3d& y, ImuSample* out) const {
-    const Matrix3d C_n_b = EulerToDcm(k.euler).transpose();
+    const EulerTrig trig(k.euler);  // once for both uses
+    const Matrix3d C_n_b = EulerToDcm(trig).transpose();
     const Vector3d omega_ie_n = env.EarthRate(y.x());
     const Vector3d omega_en_n = env.TransportRate(y.x(), y.z(), k.v_eb_n);
     // omega_ib_b = omega_nb_b + C_n_b (omega_ie_n + omega_en_n)             Groves (5.40)
-    out->omega_ib_b =
-        EulerRatesToBodyRate(k.euler, k.euler_rates) + C_n_b * (omega_ie_n + omega_en_n);
+    out->omega_ib_b = EulerRatesToBodyRate(trig, k.euler_rates) + C_n_b * (omega_ie_n + omega_en_n);
     // f_ib_b = C_n_b (dv_eb_n/dt - g_b_n + (omega_en_n + 2 omega_ie_n) x v_eb_n)   Groves (5.54)
     out->f_ib_b = C_n_b * (k.a_eb_n - env.Gravity(y.x(), y.z()) +
                            (omega_en_n + 2.0 * omega_ie_n).cross(k.v_eb_n));

@@ -28,6 +28,16 @@ struct EulerAngles {
 Matrix3d Skew(const Vector3d& a);
 
 Matrix3d EulerToDcm(const EulerAngles& e);  // C_b_n
+
+// sin and cos of the three Euler angles, for code that needs both EulerToDcm and
+// EulerRatesToBodyRate of the same angles (the trajectory generator: 3 sin/cos pairs instead of 5).
+struct EulerTrig {
+  explicit EulerTrig(const EulerAngles& e);
+  double sp, cp;  // roll
+  double st, ct;  // pitch
+  double ss, cs;  // yaw
+};
+Matrix3d EulerToDcm(const EulerTrig& t);
 EulerAngles DcmToEuler(const Matrix3d& C_b_n);
 
 // Exact rotation matrix of a rotation vector (Rodrigues), with Taylor series near zero so the
@@ -42,6 +52,7 @@ Vector3d QuaternionToRotationVector(const Quaterniond& q);
 //                 theta' cos phi + psi' cos theta sin phi,
 //                 -theta' sin phi + psi' cos theta cos phi]          Groves (2.58) inverse
 Vector3d EulerRatesToBodyRate(const EulerAngles& e, const Vector3d& euler_rates);
+Vector3d EulerRatesToBodyRate(const EulerTrig& t, const Vector3d& euler_rates);
 
 // Small-angle attitude error of `estimate` relative to `truth` as roll/pitch/yaw differences
 // wrapped to (-pi, pi].
