@@ -47,7 +47,8 @@ double SomiglianaGravity(double L_b) { return SomiglianaGravityOfSin(Sin(L_b)); 
 Vector3d GravityNed(double L_b, double h_b) {
   const double a = kWgs84SemiMajorAxis_m;
   const double f = kWgs84Flattening;
-  const double s = Sin(L_b);
+  const SinCosOf sc(L_b);
+  const double s = sc.s;
   const double s2 = s * s;
   // m = omega_ie^2 a^2 b / mu, the ratio of centrifugal to gravitational acceleration at the
   // equator (NIMA TR8350.2 table 3.3: 0.00344978650684).
@@ -56,7 +57,7 @@ Vector3d GravityNed(double L_b, double h_b) {
   const double g0 = SomiglianaGravityOfSin(s);
   const double g_D =
       g0 * (1.0 - 2.0 / a * (1.0 + f * (1.0 - 2.0 * s2) + m) * h_b + 3.0 * h_b * h_b / (a * a));
-  const double g_N = -8.08e-9 * h_b * Sin(2.0 * L_b);
+  const double g_N = -8.08e-9 * h_b * (2.0 * s * sc.c);  // sin 2L = 2 sin L cos L
   return Vector3d(g_N, 0.0, g_D);
 }
 

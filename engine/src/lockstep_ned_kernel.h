@@ -60,11 +60,6 @@ struct Kernel {
   static V3 Splat3(double x, double y, double z) { return {Splat(x), Splat(y), Splat(z)}; }
 
   static P Sqrt(P x) { return lane_math::Sqrt<W>(x); }
-  static P Sin(P x) {
-    P s, c;
-    lane_math::SinCos<W>(x, s, c);
-    return s;
-  }
   // All-ones lanes where the comparison holds.
   static U Mask(decltype(P{} < P{}) m) {
     if constexpr (W == 1) {
@@ -205,7 +200,7 @@ struct Kernel {
     constexpr double m = kOmega * kOmega * kA * kA * kB / kGM;
     const P g_D =
         g0 * (1.0 - 2.0 / kA * (1.0 + kF * (1.0 - 2.0 * s2) + m) * h + 3.0 * h * h / (kA * kA));
-    const P g_N = -8.08e-9 * h * Sin(2.0 * l.L);
+    const P g_N = -8.08e-9 * h * (2.0 * l.s * l.c);  // sin 2L = 2 sin L cos L (earth.cc)
     return {g_N, Splat(0.0), g_D};
   }
 
