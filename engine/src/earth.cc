@@ -44,10 +44,13 @@ double TransverseRadius(double L_b) { return TransverseRadiusOfSin(Sin(L_b)); }
 
 double SomiglianaGravity(double L_b) { return SomiglianaGravityOfSin(Sin(L_b)); }
 
-Vector3d GravityNed(double L_b, double h_b) {
+namespace {
+
+// GravityNed, EarthRateNed and TransportRateNed of a latitude's sin and cos
+// (NavEnvironment::AtPoint computes those once for all three).
+Vector3d GravityNedOf(const SinCosOf& sc, double h_b) {
   const double a = kWgs84SemiMajorAxis_m;
   const double f = kWgs84Flattening;
-  const SinCosOf sc(L_b);
   const double s = sc.s;
   const double s2 = s * s;
   // m = omega_ie^2 a^2 b / mu, the ratio of centrifugal to gravitational acceleration at the
@@ -61,23 +64,30 @@ Vector3d GravityNed(double L_b, double h_b) {
   return Vector3d(g_N, 0.0, g_D);
 }
 
-Vector3d EarthRateNed(double L_b) {
-  const SinCosOf L(L_b);
+Vector3d EarthRateNedOf(const SinCosOf& L) {
   return Vector3d(kWgs84EarthRate_rad_per_s * L.c, 0.0, -kWgs84EarthRate_rad_per_s * L.s);
 }
 
-Vector3d TransportRateNed(double L_b, double h_b, const Vector3d& v_eb_n) {
-  const SinCosOf L(L_b);
+Vector3d TransportRateNedOf(const SinCosOf& L, double h_b, const Vector3d& v_eb_n) {
   const double R_E = TransverseRadiusOfSin(L.s) + h_b;
   const double R_N = MeridianRadiusOfSin(L.s) + h_b;
   return Vector3d(v_eb_n.y() / R_E, -v_eb_n.x() / R_N, -v_eb_n.y() * (L.s / L.c) / R_E);
 }
 
+}  // namespace
+
+Vector3d GravityNed(double L_b, double h_b) { return GravityNedOf(SinCosOf(L_b), h_b); }
+
+Vector3d EarthRateNed(double L_b) { return EarthRateNedOf(SinCosOf(L_b)); }
+
+Vector3d TransportRateNed(double L_b, double h_b, const Vector3d& v_eb_n) {
+  return TransportRateNedOf(SinCosOf(L_b), h_b, v_eb_n);
+}
+
 Vector3d LlhToEcef(const Llh& llh) {
   const double R_E = TransverseRadius(llh.lat_rad);
   const double cL = Cos(llh.lat_rad), sL = Sin(llh.lat_rad);
-  return Vector3d((R_E + llh.h_m) * cL * Cos(llh.lon_rad),
-                  (R_E + llh.h_m) * cL * Sin(llh.lon_rad),
+  return Vector3d((R_E + llh.h_m) * cL * Cos(llh.lon_rad), (R_E + llh.h_m) * cL * Sin(llh.lon_rad),
                   ((1.0 - kWgs84Eccentricity2) * R_E + llh.h_m) * sL);
 }
 
@@ -96,8 +106,7 @@ Llh EcefToLlh(const Vector3d& r_eb_e) {
   // of L = atan((z + e^2 R_E sin L) / p), which converges quadratically from this start.
   const double ep2 = e2 / (1.0 - e2);
   const double u = std::atan2(z * a, p * b);
-  double L =
-      std::atan2(z + ep2 * b * std::pow(Sin(u), 3), p - e2 * a * std::pow(Cos(u), 3));
+  double L = std::atan2(z + ep2 * b * std::pow(Sin(u), 3), p - e2 * a * std::pow(Cos(u), 3));
   for (int i = 0; i < 8; ++i) {
     const double R_E = TransverseRadius(L);
     const double L_next = std::atan2(z + e2 * R_E * Sin(L), p);
@@ -169,6 +178,15 @@ Vector3d NavEnvironment::EarthRate(double L_b) const {
 Vector3d NavEnvironment::TransportRate(double L_b, double h_b, const Vector3d& v_eb_n) const {
   if (model_ == EarthModel::kFlat) return Vector3d::Zero();
   return TransportRateNed(L_b, h_b, v_eb_n);
+}
+
+NavEnvironment::PointRates NavEnvironment::AtPoint(double L_b, double h_b,
+                                                   const Vector3d& v_eb_n) const {
+  if (model_ == EarthModel::kFlat) {
+    return {Vector3d::Zero(), Vector3d::Zero(), Vector3d(0.0, 0.0, flat_gravity_m_per_s2_)};
+  }
+  const SinCosOf L(L_b);
+  return {EarthRateNedOf(L), TransportRateNedOf(L, h_b, v_eb_n), GravityNedOf(L, h_b)};
 }
 
 Vector3d NavEnvironment::LlhRate(double L_b, double h_b, const Vector3d& v_eb_n) const {

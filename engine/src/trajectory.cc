@@ -1226,13 +1226,14 @@ struct TrajectoryGenerator::Impl {
   void PointSample(const Kinematics& k, const Vector3d& y, ImuSample* out) const {
     const EulerTrig trig(k.euler);  // once for both uses
     const Matrix3d C_n_b = EulerToDcm(trig).transpose();
-    const Vector3d omega_ie_n = env.EarthRate(y.x());
-    const Vector3d omega_en_n = env.TransportRate(y.x(), y.z(), k.v_eb_n);
+    const NavEnvironment::PointRates earth = env.AtPoint(y.x(), y.z(), k.v_eb_n);
+    const Vector3d& omega_ie_n = earth.omega_ie_n;
+    const Vector3d& omega_en_n = earth.omega_en_n;
     // omega_ib_b = omega_nb_b + C_n_b (omega_ie_n + omega_en_n)             Groves (5.40)
     out->omega_ib_b = EulerRatesToBodyRate(trig, k.euler_rates) + C_n_b * (omega_ie_n + omega_en_n);
     // f_ib_b = C_n_b (dv_eb_n/dt - g_b_n + (omega_en_n + 2 omega_ie_n) x v_eb_n)   Groves (5.54)
-    out->f_ib_b = C_n_b * (k.a_eb_n - env.Gravity(y.x(), y.z()) +
-                           (omega_en_n + 2.0 * omega_ie_n).cross(k.v_eb_n));
+    out->f_ib_b =
+        C_n_b * (k.a_eb_n - earth.g_b_n + (omega_en_n + 2.0 * omega_ie_n).cross(k.v_eb_n));
   }
 
   Vector3d Rate(const Vector3d& y, const Vector3d& v_eb_n) const {

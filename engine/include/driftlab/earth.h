@@ -98,6 +98,11 @@ class NavEnvironment {
   Vector3d Gravity(double L_b, double h_b) const;                                // g_b_n
   Vector3d EarthRate(double L_b) const;                                          // omega_ie_n
   Vector3d TransportRate(double L_b, double h_b, const Vector3d& v_eb_n) const;  // omega_en_n
+  // EarthRate, TransportRate and Gravity at one point, the same values, with one sin/cos of L.
+  struct PointRates {
+    Vector3d omega_ie_n, omega_en_n, g_b_n;
+  };
+  PointRates AtPoint(double L_b, double h_b, const Vector3d& v_eb_n) const;
   // Rate of change of (L, lambda, h) for NED velocity v_eb_n. Groves (2.111).
   Vector3d LlhRate(double L_b, double h_b, const Vector3d& v_eb_n) const;
   // Position error of `estimate` relative to `truth`, in metres along N, E, D at the truth point,
