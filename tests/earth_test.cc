@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace driftlab {
@@ -125,6 +126,27 @@ TEST(EarthTest, NedRoundTripAndSmallDisplacementsFollowTheRadii) {
   // The environment's metre scaling agrees with the exact conversion to first order.
   const NavEnvironment env = NavEnvironment::Wgs84();
   EXPECT_LT((env.PositionErrorNed(north, ref) - Vector3d(d, 0, 0)).norm(), 1e-6);
+}
+
+TEST(EarthTest, LatitudeNearMatchesLongDoubleSinCosOnBothItsPaths) {
+  // Latitude::Near rotates a known latitude's sin/cos by d = L - L0 with the Taylor series of
+  // sin d, cos d (truncation < 3e-24 for |d| <= 0.01) and takes a full sin/cos beyond. Error:
+  // the known sin/cos within 3e-16 (PolynomialMathTest), times |cos d| + |sin d| <= 1.42, plus
+  // two roundings of ~1.1e-16 each: 8e-16 absolute. At d = 0.5 or 3 the series alone would be
+  // off by > 1e-9, so these points show that the full sin/cos is taken there.
+  double max_error = 0.0;
+  for (int i = -30; i <= 30; ++i) {
+    const double L0 = 1.55 * i / 30.0;
+    const NavEnvironment::Latitude known = NavEnvironment::Latitude::Of(L0);
+    for (double d : {0.0, 1e-12, -3e-9, 5e-7, -2e-5, 1e-3, -0.0099, 0.0101, -0.5, 3.0}) {
+      const NavEnvironment::Latitude near = NavEnvironment::Latitude::Near(known, L0 + d);
+      const long double L = static_cast<long double>(L0 + d);
+      EXPECT_EQ(near.L_rad, L0 + d);
+      max_error = std::max(max_error, std::fabs(near.sin_L - static_cast<double>(std::sin(L))));
+      max_error = std::max(max_error, std::fabs(near.cos_L - static_cast<double>(std::cos(L))));
+    }
+  }
+  EXPECT_LT(max_error, 8e-16);
 }
 
 TEST(EarthTest, EarthAndTransportRatesFollowGroves) {

@@ -12,6 +12,7 @@ namespace {
 struct SinCosOf {
   double s, c;
   explicit SinCosOf(double x) { lane_math::SinCos<1>(x, s, c); }
+  explicit SinCosOf(const NavEnvironment::Latitude& L) : s(L.sin_L), c(L.cos_L) {}
 };
 double Sin(double x) { return SinCosOf(x).s; }
 double Cos(double x) { return SinCosOf(x).c; }
@@ -180,12 +181,31 @@ Vector3d NavEnvironment::TransportRate(double L_b, double h_b, const Vector3d& v
   return TransportRateNed(L_b, h_b, v_eb_n);
 }
 
+NavEnvironment::Latitude NavEnvironment::Latitude::Of(double L_rad) {
+  Latitude l;
+  l.L_rad = L_rad;
+  lane_math::SinCos<1>(L_rad, l.sin_L, l.cos_L);
+  return l;
+}
+
+NavEnvironment::Latitude NavEnvironment::Latitude::Near(const Latitude& known, double L_rad) {
+  Latitude l;
+  l.L_rad = L_rad;
+  lane_math::SinCosNear<1>(L_rad, known.L_rad, known.sin_L, known.cos_L, l.sin_L, l.cos_L);
+  return l;
+}
+
 NavEnvironment::PointRates NavEnvironment::AtPoint(double L_b, double h_b,
+                                                   const Vector3d& v_eb_n) const {
+  return AtPoint(Latitude::Of(L_b), h_b, v_eb_n);
+}
+
+NavEnvironment::PointRates NavEnvironment::AtPoint(const Latitude& lat, double h_b,
                                                    const Vector3d& v_eb_n) const {
   if (model_ == EarthModel::kFlat) {
     return {Vector3d::Zero(), Vector3d::Zero(), Vector3d(0.0, 0.0, flat_gravity_m_per_s2_)};
   }
-  const SinCosOf L(L_b);
+  const SinCosOf L(lat);
   return {EarthRateNedOf(L), TransportRateNedOf(L, h_b, v_eb_n), GravityNedOf(L, h_b)};
 }
 
@@ -194,7 +214,14 @@ Vector3d NavEnvironment::LlhRate(double L_b, double h_b, const Vector3d& v_eb_n)
     // Flat frame: h plays no part in the metre scaling and there is no convergence of meridians.
     return Vector3d(v_eb_n.x() / flat_R_N_m_, v_eb_n.y() / flat_R_E_m_, -v_eb_n.z());
   }
-  const SinCosOf L(L_b);
+  return LlhRate(Latitude::Of(L_b), h_b, v_eb_n);
+}
+
+Vector3d NavEnvironment::LlhRate(const Latitude& lat, double h_b, const Vector3d& v_eb_n) const {
+  if (model_ == EarthModel::kFlat) {
+    return Vector3d(v_eb_n.x() / flat_R_N_m_, v_eb_n.y() / flat_R_E_m_, -v_eb_n.z());
+  }
+  const SinCosOf L(lat);
   return Vector3d(v_eb_n.x() / (MeridianRadiusOfSin(L.s) + h_b),
                   v_eb_n.y() / ((TransverseRadiusOfSin(L.s) + h_b) * L.c), -v_eb_n.z());
 }

@@ -235,5 +235,31 @@ inline void SinCos(D<W> x, D<W>& sin_out, D<W>& cos_out) {
   SinCosOfQuadrant<W>(t, q, sin_out, cos_out);
 }
 
+// sin x and cos x from s0 = sin x0, c0 = cos x0 of a nearby x0 (a latitude within one step of
+// another): the angle-sum rotation s0 cos d + c0 sin d, c0 cos d - s0 sin d, d = x - x0, with the
+// Taylor series of sin d to d^7 and cos d to d^6 (|d| <= 0.01: omitted terms < 3e-24 and
+// 2.5e-21, below rounding), within ~2 ulp as SinCos is within 1. A lane with |d| > 0.01 takes
+// SinCos(x) itself (computed only if some lane needs it, chosen per lane: a lane's bits never
+// depend on the other lanes).
+template <int W>
+inline void SinCosNear(D<W> x, D<W> x0, D<W> s0, D<W> c0, D<W>& sin_out, D<W>& cos_out) {
+  const D<W> d = x - x0;
+  const D<W> d2 = d * d;
+  const D<W> sin_d = d - d * d2 * ((1.0 / 6.0) - d2 * ((1.0 / 120.0) - d2 * (1.0 / 5040.0)));
+  const D<W> cos_d = 1.0 - d2 * (0.5 - d2 * ((1.0 / 24.0) - d2 * (1.0 / 720.0)));
+  sin_out = s0 * cos_d + c0 * sin_d;
+  cos_out = c0 * cos_d - s0 * sin_d;
+  // |d| > 0.01, as a mask: d2's bit pattern against 1e-4's (both non-negative or NaN).
+  const U<W> far = GreaterMask<W>(AsBits<W>(d2), __builtin_bit_cast(uint64_t, 1e-4) + U<W>{});
+  bool any_far = false;
+  for (int i = 0; i < W; ++i) any_far = any_far || GetLane<W>(far, i) != 0;
+  if (any_far) {
+    D<W> s_full, c_full;
+    SinCos<W>(x, s_full, c_full);
+    sin_out = Select<W>(far, s_full, sin_out);
+    cos_out = Select<W>(far, c_full, cos_out);
+  }
+}
+
 }  // namespace
 }  // namespace driftlab::lane_math

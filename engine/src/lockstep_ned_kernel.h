@@ -171,28 +171,11 @@ struct Kernel {
     return LatOfSinCos(L, s, c);
   }
   // The Lat of a latitude L near one already known (the step's midpoint and end from its start;
-  // |L - base.L| ~ v dt / R, 5e-7 rad for 300 m/s at 100 Hz): sin and cos by the angle-sum
-  // rotation with the Taylor series of sin d and cos d, d = L - base.L, to d^7 and d^6
-  // (|d| <= 1e-2: omitted terms < 3e-24 and 2.5e-21, below rounding), so that the step needs one
-  // full sin/cos of latitude instead of five. A lane with |d| > 1e-2 takes the full SinCos
-  // (computed only if some lane needs it; chosen per lane, so a run's bits never depend on the
-  // other runs of its group). Within ~2 ulp of sin L and cos L, as SinCos is within 1.
+  // |L - base.L| ~ v dt / R, 5e-7 rad for 300 m/s at 100 Hz) by lane_math::SinCosNear, so that
+  // the step needs one full sin/cos of latitude instead of five.
   static Lat LatNear(const Lat& base, P L) {
-    const P d = L - base.L;
-    const P d2 = d * d;
-    const P sin_d = d - d * d2 * ((1.0 / 6.0) - d2 * ((1.0 / 120.0) - d2 * (1.0 / 5040.0)));
-    const P cos_d = 1.0 - d2 * (0.5 - d2 * ((1.0 / 24.0) - d2 * (1.0 / 720.0)));
-    P s = base.s * cos_d + base.c * sin_d;
-    P c = base.c * cos_d - base.s * sin_d;
-    const U far = Mask(d2 > 1e-4);
-    bool any_far = false;
-    for (int i = 0; i < W; ++i) any_far = any_far || lane_math::GetLane<W>(far, i) != 0;
-    if (any_far) {
-      P s_full, c_full;
-      lane_math::SinCos<W>(L, s_full, c_full);
-      s = lane_math::Select<W>(far, s_full, s);
-      c = lane_math::Select<W>(far, c_full, c);
-    }
+    P s, c;
+    lane_math::SinCosNear<W>(L, base.L, base.s, base.c, s, c);
     return LatOfSinCos(L, s, c);
   }
   static Lat LatOfSinCos(P L, P s, P c) {

@@ -1224,9 +1224,14 @@ struct TrajectoryGenerator::Impl {
   }
 
   void PointSample(const Kinematics& k, const Vector3d& y, ImuSample* out) const {
+    PointSample(k, y, NavEnvironment::Latitude::Of(y.x()), out);
+  }
+  // `lat` is y's latitude with its sin and cos.
+  void PointSample(const Kinematics& k, const Vector3d& y, const NavEnvironment::Latitude& lat,
+                   ImuSample* out) const {
     const EulerTrig trig(k.euler);  // once for both uses
     const Matrix3d C_n_b = EulerToDcm(trig).transpose();
-    const NavEnvironment::PointRates earth = env.AtPoint(y.x(), y.z(), k.v_eb_n);
+    const NavEnvironment::PointRates earth = env.AtPoint(lat, y.z(), k.v_eb_n);
     const Vector3d& omega_ie_n = earth.omega_ie_n;
     const Vector3d& omega_en_n = earth.omega_en_n;
     // omega_ib_b = omega_nb_b + C_n_b (omega_ie_n + omega_en_n)             Groves (5.40)
@@ -1236,8 +1241,10 @@ struct TrajectoryGenerator::Impl {
         C_n_b * (k.a_eb_n - earth.g_b_n + (omega_en_n + 2.0 * omega_ie_n).cross(k.v_eb_n));
   }
 
-  Vector3d Rate(const Vector3d& y, const Vector3d& v_eb_n) const {
-    return env.LlhRate(y.x(), y.z(), v_eb_n);
+  // The rate at y, its latitude's sin and cos from those of a nearby known latitude.
+  Vector3d Rate(const NavEnvironment::Latitude& known, const Vector3d& y,
+                const Vector3d& v_eb_n) const {
+    return env.LlhRate(NavEnvironment::Latitude::Near(known, y.x()), y.z(), v_eb_n);
   }
 
   // One RK4 sub-step of the position over [ta, tb] on piece p, with the Gauss-Legendre quadrature
@@ -1247,10 +1254,13 @@ struct TrajectoryGenerator::Impl {
     const Vector3d y0 = llh;
     const Kinematics k_m = p.Evaluate(ta + 0.5 * h);
     const Kinematics k_b = p.Evaluate(tb);
-    const Vector3d f0 = Rate(y0, k_a->v_eb_n);
-    const Vector3d f1 = Rate(y0 + 0.5 * h * f0, k_m.v_eb_n);
-    const Vector3d f2 = Rate(y0 + 0.5 * h * f1, k_m.v_eb_n);
-    const Vector3d f3 = Rate(y0 + h * f2, k_b.v_eb_n);
+    // One full sin/cos of latitude a sub-step: every other point's from y0's
+    // (NavEnvironment::Latitude::Near; the points are within one sub-step of y0).
+    const NavEnvironment::Latitude lat0 = NavEnvironment::Latitude::Of(y0.x());
+    const Vector3d f0 = env.LlhRate(lat0, y0.z(), k_a->v_eb_n);
+    const Vector3d f1 = Rate(lat0, y0 + 0.5 * h * f0, k_m.v_eb_n);
+    const Vector3d f2 = Rate(lat0, y0 + 0.5 * h * f1, k_m.v_eb_n);
+    const Vector3d f3 = Rate(lat0, y0 + h * f2, k_b.v_eb_n);
     const Vector3d delta = (h / 6.0) * (f0 + 2.0 * f1 + 2.0 * f2 + f3);
     Vector3d y1;
     for (int i = 0; i < 3; ++i) {
@@ -1260,7 +1270,7 @@ struct TrajectoryGenerator::Impl {
       llh_lo(i) = (a - (sum - b_virtual)) + (b - b_virtual);
       y1(i) = sum;
     }
-    const Vector3d fe = Rate(y1, k_b.v_eb_n);
+    const Vector3d fe = Rate(lat0, y1, k_b.v_eb_n);
     for (int j = 0; j < 4; ++j) {
       const double theta = 0.5 * (1.0 + kGaussNode[j]);
       const Kinematics k = p.Evaluate(ta + theta * h);
@@ -1269,7 +1279,7 @@ struct TrajectoryGenerator::Impl {
       const Vector3d y = (2.0 * t3 - 3.0 * t2 + 1.0) * y0 + (t3 - 2.0 * t2 + theta) * h * f0 +
                          (-2.0 * t3 + 3.0 * t2) * y1 + (t3 - t2) * h * fe;
       ImuSample s;
-      PointSample(k, y, &s);
+      PointSample(k, y, NavEnvironment::Latitude::Near(lat0, y.x()), &s);
       const double w = 0.5 * h * kGaussWeight[j];
       inc->delta_theta_ib_b += w * s.omega_ib_b;
       inc->delta_v_ib_b += w * s.f_ib_b;

@@ -98,13 +98,23 @@ class NavEnvironment {
   Vector3d Gravity(double L_b, double h_b) const;                                // g_b_n
   Vector3d EarthRate(double L_b) const;                                          // omega_ie_n
   Vector3d TransportRate(double L_b, double h_b, const Vector3d& v_eb_n) const;  // omega_en_n
+  // A latitude with its sine and cosine, for code that evaluates the Earth model at several
+  // nearby latitudes (the trajectory generator's sub-step): Near() takes them from a known one by
+  // the angle-sum rotation (lane_math::SinCosNear, within ~2 ulp of a full sin/cos).
+  struct Latitude {
+    double L_rad = 0.0, sin_L = 0.0, cos_L = 1.0;
+    static Latitude Of(double L_rad);
+    static Latitude Near(const Latitude& known, double L_rad);
+  };
   // EarthRate, TransportRate and Gravity at one point, the same values, with one sin/cos of L.
   struct PointRates {
     Vector3d omega_ie_n, omega_en_n, g_b_n;
   };
   PointRates AtPoint(double L_b, double h_b, const Vector3d& v_eb_n) const;
+  PointRates AtPoint(const Latitude& L, double h_b, const Vector3d& v_eb_n) const;
   // Rate of change of (L, lambda, h) for NED velocity v_eb_n. Groves (2.111).
   Vector3d LlhRate(double L_b, double h_b, const Vector3d& v_eb_n) const;
+  Vector3d LlhRate(const Latitude& L, double h_b, const Vector3d& v_eb_n) const;
   // Position error of `estimate` relative to `truth`, in metres along N, E, D at the truth point,
   // using the curvilinear-to-metre scaling of this environment.
   Vector3d PositionErrorNed(const Llh& estimate, const Llh& truth) const;
