@@ -95,9 +95,16 @@ using AdvanceFn = void (*)(const KernelJob& job, const KernelInputs& in, int64_t
 using FillFn = void (*)(const uint32_t* key, uint32_t run_word, uint32_t stream_word,
                         uint64_t first_index, double* out, int count);
 
+// N(0, 1) deviates of the kMaxLanes streams (key[2], run_words[lane], stream_word), blocks
+// [block0, block0 + nblocks): deviate 4 b + i of lane l into out[4 (b - block0) + i][l]
+// (random_kernels::GaussianAcrossRuns, the same numbers as FillFn's).
+using FillLanesFn = void (*)(const uint32_t* key, const uint32_t* run_words, uint32_t stream_word,
+                             uint64_t block0, int nblocks, double (*out)[kMaxLanes]);
+
 struct KernelEntry {
   AdvanceFn advance = nullptr;
   FillFn fill = nullptr;
+  FillLanesFn fill_lanes = nullptr;
 };
 
 // Per-ISA entry points (defined in lockstep_ned_<isa>.cc; null where the build or the

@@ -139,7 +139,7 @@ void LoadBlock(const LockstepJob& job, const Kernel& kernel, int64_t block_begin
                GroupStreams* streams, LockstepGroup* group) {
   if (!job.kernel.has_sensor) return;
   const uint64_t b0 = static_cast<uint64_t>(block_begin);
-  double buffer[kBlock];
+  static_assert(kBlock % 4 == 0, "blocks start at a Philox block");
   for (int t = 0; t < 2; ++t) {
     const TriadParams& p = job.kernel.triad[t];
     TriadLanes& lanes = group->triad[t];
@@ -147,11 +147,19 @@ void LoadBlock(const LockstepJob& job, const Kernel& kernel, int64_t block_begin
       if (!TermOn(p, term)) continue;
       double(*dst)[kBlock][kMaxLanes] = PerSampleBuffer(lanes, term);
       for (int axis = 0; axis < 3; ++axis) {
-        for (int lane = 0; lane < group->lanes; ++lane) {
-          const RandomStream& r = streams->per_sample[t][term][axis][lane];
-          kernel.fill(r.key().data(), r.run_word(), r.stream_word(), b0, buffer, kBlock);
-          for (int s = 0; s < kBlock; ++s) dst[axis][s][lane] = buffer[s];
+        // The lanes' streams differ only in their run word (same seed, same stream); lanes past
+        // group->lanes repeat lane 0's (their numbers are not used).
+        const RandomStream* r = streams->per_sample[t][term][axis];
+        uint32_t run_words[kMaxLanes];
+        for (int lane = 0; lane < kMaxLanes; ++lane) {
+          const RandomStream& rl = r[lane < group->lanes ? lane : 0];
+          if (rl.key() != r[0].key() || rl.stream_word() != r[0].stream_word()) {
+            throw std::logic_error("lockstep: the lanes of a group draw from different streams");
+          }
+          run_words[lane] = rl.run_word();
         }
+        kernel.fill_lanes(r[0].key().data(), run_words, r[0].stream_word(), b0 / 4, kBlock / 4,
+                          dst[axis]);
       }
     }
     // Flicker component j advances at steps d = 2^m, 2 * 2^m, ... with deviate (d >> m) - 1.
@@ -253,6 +261,7 @@ Kernel KernelFor(Isa isa) {
   }
   k.advance = entry.advance;
   k.fill = entry.fill;
+  k.fill_lanes = entry.fill_lanes;
   return k;
 }
 

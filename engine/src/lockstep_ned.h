@@ -44,6 +44,7 @@ struct Kernel {
   int width = 2;  // lanes per group
   AdvanceFn advance = nullptr;
   FillFn fill = nullptr;
+  FillLanesFn fill_lanes = nullptr;
   const char* name = "baseline";
 };
 

@@ -17,9 +17,14 @@ void Fill(const uint32_t* key, uint32_t run_word, uint32_t stream_word, uint64_t
   random_kernels::FillGaussianRange(key, run_word, stream_word, first_index, out,
                                     static_cast<size_t>(count));
 }
+void FillLanes(const uint32_t* key, const uint32_t* run_words, uint32_t stream_word,
+               uint64_t block0, int nblocks, double (*out)[kMaxLanes]) {
+  random_kernels::GaussianAcrossRuns<4, 4, kMaxLanes>(key, run_words, stream_word, block0, nblocks,
+                                                    &out[0][0]);
+}
 }  // namespace
 
-KernelEntry EntryAvx2() { return {&Advance4, &Fill}; }
+KernelEntry EntryAvx2() { return {&Advance4, &Fill, &FillLanes}; }
 #else
 KernelEntry EntryAvx2() { return {}; }
 #endif

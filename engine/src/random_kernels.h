@@ -11,7 +11,7 @@
 
 #include "lane_math.h"
 
-#if defined(__AVX2__)
+#if defined(__SSE2__)
 #include <immintrin.h>
 #endif
 
@@ -81,10 +81,35 @@ constexpr int kPhiloxLanes = 1;
 // same on every path.
 template <int W>
 inline lane_math::U<W> MulLow32(lane_math::U<W> a, uint32_t m) {
+#if defined(__AVX512F__)
+  if constexpr (W == 8) {
+    // GCC 12's _mm512_mul_epu32 passes an undefined merge operand that -Wmaybe-uninitialized
+    // reports; the instruction does not read it.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+    return reinterpret_cast<lane_math::U<W>>(
+        _mm512_mul_epu32(reinterpret_cast<__m512i>(a), _mm512_set1_epi64(m)));
+#pragma GCC diagnostic pop
+  }
+#endif
 #if defined(__AVX2__)
   if constexpr (W == 4) {
     return reinterpret_cast<lane_math::U<W>>(
         _mm256_mul_epu32(reinterpret_cast<__m256i>(a), _mm256_set1_epi64x(m)));
+  }
+#endif
+#if defined(__SSE2__)
+  if constexpr (W == 2) {
+    return reinterpret_cast<lane_math::U<W>>(
+        _mm_mul_epu32(reinterpret_cast<__m128i>(a), _mm_set1_epi64x(m)));
+  } else if constexpr (W > 2) {  // the two halves, each by the widest instruction above
+    lane_math::U<W / 2> half[2];
+    __builtin_memcpy(half, &a, sizeof(a));
+    half[0] = MulLow32<W / 2>(half[0], m);
+    half[1] = MulLow32<W / 2>(half[1], m);
+    lane_math::U<W> r;
+    __builtin_memcpy(&r, half, sizeof(r));
+    return r;
   }
 #endif
   return a * static_cast<uint64_t>(m);
@@ -185,6 +210,80 @@ inline void UniformChunk(const uint32_t* key, uint32_t run_word, uint32_t stream
   for (int b = 0; b < nblocks; ++b) {
     for (int lane = 0; lane < 4; ++lane) {
       out[4 * b + lane] = (static_cast<double>(x[lane][b]) + 0.5) * kTwoPowMinus32;
+    }
+  }
+}
+
+// Deviates of several runs at once (the lockstep kernels): the streams (key, run_words[lane],
+// stream_word) of kLanes runs that differ only in their run word, blocks [block0, block0 +
+// nblocks), deviate 4 b + i of lane l into out[(4 (b - block0) + i) * kLanes + l], i.e. rows of
+// one sample for all lanes, the layout the kernels read. W lanes per vector: Philox and
+// Box-Muller across runs rather than across blocks, so each row is one vector store (no
+// interleaving of the four words of a block, no copy). The same operations on each lane as
+// GaussianChunk: the same bits.
+template <int W, int kLanes, int kRowStride>
+inline void GaussianAcrossRuns(const uint32_t* key, const uint32_t* run_words, uint32_t stream_word,
+                               uint64_t block0, int nblocks, double* out) {
+  using lane_math::D;
+  using lane_math::U;
+  static_assert(kLanes % W == 0, "whole vectors of lanes");
+  constexpr int kG = kLanes / W;
+  U<W> run[kG];
+  for (int g = 0; g < kG; ++g) {
+    if constexpr (W == 1) {
+      run[g] = run_words[g];
+    } else {
+      for (int i = 0; i < W; ++i) run[g][i] = run_words[g * W + i];
+    }
+  }
+  // Philox for a chunk of blocks, then Box-Muller on its words: each loop's iterations are
+  // independent and short, so the processor overlaps them (a block's ten rounds are one chain).
+  for (int b0 = 0; b0 < nblocks; b0 += kChunkBlocks) {
+    const int n = nblocks - b0 < kChunkBlocks ? nblocks - b0 : kChunkBlocks;
+    U<W> words[kChunkBlocks][kG][4];
+    for (int b = 0; b < n; ++b) {
+      const uint64_t block = block0 + static_cast<uint64_t>(b0 + b);
+#pragma GCC unroll 4
+      for (int g = 0; g < kG; ++g) {
+        U<W> c0 = U<W>{} + (block & 0xffffffffu);
+        U<W> c1 = U<W>{} + (block >> 32);
+        U<W> c2 = run[g];
+        U<W> c3 = U<W>{} + stream_word;
+        uint32_t k0 = key[0], k1 = key[1];
+#pragma GCC unroll 10
+        for (int round = 0; round < 10; ++round) {  // kPhiloxRounds (random.h)
+          if (round > 0) {
+            k0 += kPhiloxW0;
+            k1 += kPhiloxW1;
+          }
+          const U<W> p0 = MulLow32<W>(c0, kPhiloxM0);
+          const U<W> p1 = MulLow32<W>(c2, kPhiloxM1);
+          c0 = (p1 >> 32) ^ c1 ^ static_cast<uint64_t>(k0);
+          c1 = p1 & 0xffffffffu;
+          c2 = (p0 >> 32) ^ c3 ^ static_cast<uint64_t>(k1);
+          c3 = p0 & 0xffffffffu;
+        }
+        words[b][g][0] = c0;
+        words[b][g][1] = c1;
+        words[b][g][2] = c2;
+        words[b][g][3] = c3;
+      }
+    }
+    for (int b = 0; b < n; ++b) {
+#pragma GCC unroll 4
+      for (int g = 0; g < kG; ++g) {
+        double* row = out + static_cast<size_t>(4 * (b0 + b)) * kRowStride + g * W;
+#pragma GCC unroll 2
+        for (int pair = 0; pair < 2; ++pair) {
+          const D<W> u1 = (lane_math::ToDouble<W>(words[b][g][2 * pair]) + 1.0) * kTwoPowMinus32;
+          const D<W> radius = lane_math::Sqrt<W>(-2.0 * lane_math::Log<W>(u1));
+          D<W> s, c;
+          lane_math::SinCosTwoPi<W>(words[b][g][2 * pair + 1], s, c);
+          const D<W> z0 = radius * c, z1 = radius * s;
+          __builtin_memcpy(row + (2 * pair) * kRowStride, &z0, sizeof(z0));
+          __builtin_memcpy(row + (2 * pair + 1) * kRowStride, &z1, sizeof(z1));
+        }
+      }
     }
   }
 }
