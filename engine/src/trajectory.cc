@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <charconv>
 #include <cmath>
 #include <memory>
@@ -97,6 +98,55 @@ struct Ramp {
   }
 };
 
+// sin and cos of the angles the generator evaluates at every quadrature point - the track angle
+// and the three Euler angles - remembered per slot with the argument's bit pattern: along a
+// straight or level segment they stay the same for thousands of points, and std::sin / std::cos
+// of the same argument give the same values, so the truth is the same bits as without it. One
+// per generator (TrajectoryGenerator::Next's path only; the const queries pass none).
+class TrigMemo {
+ public:
+  enum Slot { kTrack = 0, kRoll = 1, kPitch = 2, kYaw = 3 };
+  void SinCos(Slot slot, double x, double* s, double* c) {
+    Entry& e = entries_[slot];
+    const uint64_t bits = std::bit_cast<uint64_t>(x);
+    if (!e.valid || e.bits != bits) {
+      e.s = std::sin(x);
+      e.c = std::cos(x);
+      e.bits = bits;
+      e.valid = true;
+    }
+    *s = e.s;
+    *c = e.c;
+  }
+
+ private:
+  struct Entry {
+    uint64_t bits = 0;
+    double s = 0.0, c = 1.0;
+    bool valid = false;
+  };
+  Entry entries_[4];
+};
+
+// sin and cos of x, through `memo`'s slot when there is one.
+void SinCosVia(TrigMemo* memo, TrigMemo::Slot slot, double x, double* s, double* c) {
+  if (memo != nullptr) {
+    memo->SinCos(slot, x, s, c);
+  } else {
+    *s = std::sin(x);
+    *c = std::cos(x);
+  }
+}
+
+EulerTrig EulerTrigVia(TrigMemo* memo, const EulerAngles& e) {
+  if (memo == nullptr) return EulerTrig(e);
+  double sp, cp, st, ct, ss, cs;
+  memo->SinCos(TrigMemo::kRoll, e.roll_rad, &sp, &cp);
+  memo->SinCos(TrigMemo::kPitch, e.pitch_rad, &st, &ct);
+  memo->SinCos(TrigMemo::kYaw, e.yaw_rad, &ss, &cs);
+  return EulerTrig(sp, cp, st, ct, ss, cs);
+}
+
 // A sin(omega s + phase) and its first two derivatives.
 struct Wave {
   double amplitude = 0.0, omega = 0.0, phase = 0.0;
@@ -138,7 +188,7 @@ struct TrackPiece {
            zigzag.amplitude == 0.0 && !ship;
   }
 
-  Kinematics Evaluate(double s) const {
+  Kinematics Evaluate(double s, TrigMemo* memo) const {
     Kinematics k;
     const double V = speed.Value(s), dV = speed.slope;
     double zx, zdx, zddx;
@@ -147,7 +197,8 @@ struct TrackPiece {
     const double dchi = chi1 + 2.0 * chi2 * s + zdx;
     const double ddchi = 2.0 * chi2 + zddx;
     double vD = v_down.Value(s), dvD = v_down.slope;
-    const double c = std::cos(chi), sn = std::sin(chi);
+    double sn, c;
+    SinCosVia(memo, TrigMemo::kTrack, chi, &sn, &c);
 
     double pitch = pitch_offset, dpitch = 0.0;
     if (pitch_follows) {
@@ -207,14 +258,14 @@ struct BodyPiece {
 
   bool Uniform() const { return e1.isZero(0.0) && e2.isZero(0.0) && b_slope.isZero(0.0); }
 
-  Kinematics Evaluate(double s) const {
+  Kinematics Evaluate(double s, TrigMemo* memo) const {
     Kinematics k;
     const Vector3d e = e0 + (e1 + e2 * s) * s;
     k.euler = EulerAngles{e.x(), e.y(), e.z()};
     k.euler_rates = e1 + 2.0 * s * e2;
     const Vector3d v_b = s <= 0.5 * duration ? Vector3d(b_start + b_slope * s)
                                              : Vector3d(b_end - b_slope * (duration - s));
-    const EulerTrig trig(k.euler);
+    const EulerTrig trig = EulerTrigVia(memo, k.euler);
     const Matrix3d C_b_n = EulerToDcm(trig);
     const Vector3d omega_nb_b = EulerRatesToBodyRate(trig, k.euler_rates);
     k.v_eb_n = C_b_n * v_b;
@@ -227,7 +278,7 @@ struct BodyPiece {
 struct SplinePiece {
   std::array<std::array<double, 4>, 6> c{};
 
-  Kinematics Evaluate(double s) const {
+  Kinematics Evaluate(double s, TrigMemo*) const {
     double value[6], rate[6];
     for (int i = 0; i < 6; ++i) {
       const auto& p = c[static_cast<size_t>(i)];
@@ -249,9 +300,9 @@ struct Piece {
   double max_substep_s = kDynamicSubstep_s;
   std::variant<TrackPiece, BodyPiece, SplinePiece> kin;
 
-  Kinematics Evaluate(double t) const {
+  Kinematics Evaluate(double t, TrigMemo* memo = nullptr) const {
     const double s = t - t0;
-    return std::visit([s](const auto& p) { return p.Evaluate(s); }, kin);
+    return std::visit([s, memo](const auto& p) { return p.Evaluate(s, memo); }, kin);
   }
 };
 
@@ -331,7 +382,7 @@ class Planner {
     piece.kin = p;
     pieces_->push_back(piece);
     state_.t = piece.t1;
-    const Kinematics end = p.Evaluate(duration);
+    const Kinematics end = p.Evaluate(duration, nullptr);
     state_.euler = end.euler;
     state_.v_eb_n = end.v_eb_n;
     state_.has_track = true;
@@ -1204,6 +1255,7 @@ struct TrajectoryGenerator::Impl {
   std::vector<Piece> pieces;
   std::vector<double> breakpoints;
   std::vector<std::pair<double, double>> gps_invisible_s;
+  TrigMemo trig_memo;  // Next's path only (IsStaticAt and the planner evaluate without it)
   NavState initial;
   ImuSample initial_sample;
   // Integration state at t = step / rate_hz: (L, lambda, h) as an unevaluated sum llh + llh_lo.
@@ -1223,13 +1275,13 @@ struct TrajectoryGenerator::Impl {
     return *(it - 1);
   }
 
-  void PointSample(const Kinematics& k, const Vector3d& y, ImuSample* out) const {
+  void PointSample(const Kinematics& k, const Vector3d& y, ImuSample* out) {
     PointSample(k, y, NavEnvironment::Latitude::Of(y.x()), out);
   }
   // `lat` is y's latitude with its sin and cos.
   void PointSample(const Kinematics& k, const Vector3d& y, const NavEnvironment::Latitude& lat,
-                   ImuSample* out) const {
-    const EulerTrig trig(k.euler);  // once for both uses
+                   ImuSample* out) {
+    const EulerTrig trig = EulerTrigVia(&trig_memo, k.euler);  // once for both uses
     const Matrix3d C_n_b = EulerToDcm(trig).transpose();
     const NavEnvironment::PointRates earth = env.AtPoint(lat, y.z(), k.v_eb_n);
     const Vector3d& omega_ie_n = earth.omega_ie_n;
@@ -1252,8 +1304,8 @@ struct TrajectoryGenerator::Impl {
   void SubStep(const Piece& p, double ta, double tb, Kinematics* k_a, ImuIncrement* inc) {
     const double h = tb - ta;
     const Vector3d y0 = llh;
-    const Kinematics k_m = p.Evaluate(ta + 0.5 * h);
-    const Kinematics k_b = p.Evaluate(tb);
+    const Kinematics k_m = p.Evaluate(ta + 0.5 * h, &trig_memo);
+    const Kinematics k_b = p.Evaluate(tb, &trig_memo);
     // One full sin/cos of latitude a sub-step: every other point's from y0's
     // (NavEnvironment::Latitude::Near; the points are within one sub-step of y0).
     const NavEnvironment::Latitude lat0 = NavEnvironment::Latitude::Of(y0.x());
@@ -1273,7 +1325,7 @@ struct TrajectoryGenerator::Impl {
     const Vector3d fe = Rate(lat0, y1, k_b.v_eb_n);
     for (int j = 0; j < 4; ++j) {
       const double theta = 0.5 * (1.0 + kGaussNode[j]);
-      const Kinematics k = p.Evaluate(ta + theta * h);
+      const Kinematics k = p.Evaluate(ta + theta * h, &trig_memo);
       // Cubic Hermite position on the sub-step.
       const double t2 = theta * theta, t3 = t2 * theta;
       const Vector3d y = (2.0 * t3 - 3.0 * t2 + 1.0) * y0 + (t3 - 2.0 * t2 + theta) * h * f0 +
@@ -1301,7 +1353,7 @@ struct TrajectoryGenerator::Impl {
       const Piece& p = pieces[cursor];
       const double end = cursor + 1 < pieces.size() ? std::min(tb, p.t1) : tb;
       if (!have_k) {
-        k = p.Evaluate(t);
+        k = p.Evaluate(t, &trig_memo);
         have_k = true;
       }
       if (end > t) {

@@ -33,6 +33,9 @@ Matrix3d EulerToDcm(const EulerAngles& e);  // C_b_n
 // EulerRatesToBodyRate of the same angles (the trajectory generator: 3 sin/cos pairs instead of 5).
 struct EulerTrig {
   explicit EulerTrig(const EulerAngles& e);
+  // From the six values (remembered from the same angles: the trajectory generator's TrigMemo).
+  EulerTrig(double sp_in, double cp_in, double st_in, double ct_in, double ss_in, double cs_in)
+      : sp(sp_in), cp(cp_in), st(st_in), ct(ct_in), ss(ss_in), cs(cs_in) {}
   double sp, cp;  // roll
   double st, ct;  // pitch
   double ss, cs;  // yaw
