@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <vector>
 
 namespace driftlab {
@@ -86,6 +87,25 @@ TEST(AttitudeTest, AttitudeErrorIsTheSmallRotationFromTruthToEstimate) {
   EXPECT_LT((AttitudeErrorNed(C_est, C_true) - psi).norm(), 1e-15);
   EXPECT_NEAR(WrapPi(3.0 * M_PI), M_PI, 1e-15);
   EXPECT_NEAR(WrapPi(-M_PI), M_PI, 1e-15);
+}
+
+TEST(AttitudeTest, WrapPiReturnsAnglesInItsRangeUnchangedAndWrapsTheRestByRemainder) {
+  // (-pi, pi] is returned as it is (bit for bit: the remainder by 2 pi of such an angle is the
+  // angle itself); outside, the IEEE remainder by 2 pi, moved from -pi to pi. Tolerance: none,
+  // both are exact operations.
+  EXPECT_EQ(WrapPi(M_PI), M_PI);
+  EXPECT_EQ(WrapPi(-M_PI), M_PI);
+  EXPECT_EQ(WrapPi(std::nextafter(-M_PI, 0.0)), std::nextafter(-M_PI, 0.0));
+  EXPECT_EQ(WrapPi(-0.0), -0.0);
+  EXPECT_TRUE(std::signbit(WrapPi(-0.0)));
+  for (int i = -200000; i <= 200000; ++i) {
+    const double x = 1e-4 * i + 1e-9 * (i % 13);  // -20 .. 20 rad
+    double expected = std::remainder(x, 2.0 * M_PI);
+    if (expected <= -M_PI) expected += 2.0 * M_PI;
+    ASSERT_EQ(WrapPi(x), expected) << x;
+    ASSERT_TRUE(WrapPi(x) > -M_PI && WrapPi(x) <= M_PI) << x;
+  }
+  EXPECT_TRUE(std::isnan(WrapPi(std::numeric_limits<double>::quiet_NaN())));
 }
 
 }  // namespace

@@ -98,6 +98,9 @@ Vector3d EulerRatesToBodyRate(const EulerTrig& t, const Vector3d& euler_rates) {
 }
 
 double WrapPi(double angle_rad) {
+  // Already in (-pi, pi]: remainder would return it unchanged (its quotient |x / 2pi| <= 1/2
+  // rounds to 0, a tie to even), so skip the library call.
+  if (angle_rad > -M_PI && angle_rad <= M_PI) return angle_rad;
   double w = std::remainder(angle_rad, 2.0 * M_PI);
   if (w <= -M_PI) w += 2.0 * M_PI;
   return w;
