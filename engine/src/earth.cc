@@ -28,6 +28,18 @@ double TransverseRadiusOfSin(double s) {
   return kWgs84SemiMajorAxis_m / std::sqrt(1.0 - kWgs84Eccentricity2 * s * s);
 }
 
+// Both radii of curvature from one square root: the operations of MeridianRadiusOfSin and
+// TransverseRadiusOfSin (the same d and sqrt(d)), so the same bits.
+struct RadiiOfSin {
+  double R_N, R_E;
+  explicit RadiiOfSin(double s) {
+    const double d = 1.0 - kWgs84Eccentricity2 * s * s;
+    const double sqrt_d = std::sqrt(d);
+    R_N = kWgs84SemiMajorAxis_m * (1.0 - kWgs84Eccentricity2) / (d * sqrt_d);
+    R_E = kWgs84SemiMajorAxis_m / sqrt_d;
+  }
+};
+
 double SomiglianaGravityOfSin(double s) {
   // k = b gamma_p / (a gamma_e) - 1, Groves (2.134) / NIMA TR8350.2 (4-1).
   const double k = kWgs84SemiMinorAxis_m * kWgs84GammaPole_m_per_s2 /
@@ -70,8 +82,9 @@ Vector3d EarthRateNedOf(const SinCosOf& L) {
 }
 
 Vector3d TransportRateNedOf(const SinCosOf& L, double h_b, const Vector3d& v_eb_n) {
-  const double R_E = TransverseRadiusOfSin(L.s) + h_b;
-  const double R_N = MeridianRadiusOfSin(L.s) + h_b;
+  const RadiiOfSin radii(L.s);
+  const double R_E = radii.R_E + h_b;
+  const double R_N = radii.R_N + h_b;
   return Vector3d(v_eb_n.y() / R_E, -v_eb_n.x() / R_N, -v_eb_n.y() * (L.s / L.c) / R_E);
 }
 
@@ -222,8 +235,9 @@ Vector3d NavEnvironment::LlhRate(const Latitude& lat, double h_b, const Vector3d
     return Vector3d(v_eb_n.x() / flat_R_N_m_, v_eb_n.y() / flat_R_E_m_, -v_eb_n.z());
   }
   const SinCosOf L(lat);
-  return Vector3d(v_eb_n.x() / (MeridianRadiusOfSin(L.s) + h_b),
-                  v_eb_n.y() / ((TransverseRadiusOfSin(L.s) + h_b) * L.c), -v_eb_n.z());
+  const RadiiOfSin radii(L.s);
+  return Vector3d(v_eb_n.x() / (radii.R_N + h_b), v_eb_n.y() / ((radii.R_E + h_b) * L.c),
+                  -v_eb_n.z());
 }
 
 Vector3d NavEnvironment::PositionErrorNed(const Llh& estimate, const Llh& truth) const {
