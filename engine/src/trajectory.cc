@@ -105,7 +105,8 @@ struct Ramp {
 // per generator (TrajectoryGenerator::Next's path only; the const queries pass none).
 class TrigMemo {
  public:
-  enum Slot { kTrack = 0, kRoll = 1, kPitch = 2, kYaw = 3 };
+  enum Slot { kTrack = 0, kRoll = 1, kPitch = 2, kYaw = 3, kHalfRoll = 4, kHalfPitch = 5,
+              kHalfYaw = 6 };
   void SinCos(Slot slot, double x, double* s, double* c) {
     Entry& e = entries_[slot];
     const uint64_t bits = std::bit_cast<uint64_t>(x);
@@ -125,7 +126,7 @@ class TrigMemo {
     double s = 0.0, c = 1.0;
     bool valid = false;
   };
-  Entry entries_[4];
+  Entry entries_[7];
 };
 
 // sin and cos of x, through `memo`'s slot when there is one.
@@ -1234,6 +1235,23 @@ Quaterniond EulerToQuaternion(const EulerAngles& e) {
                      Eigen::AngleAxisd(e.roll_rad, Vector3d::UnitX()));
 }
 
+// EulerToQuaternion with the half angles' sin and cos through `memo`: Eigen's own steps
+// (Quaternion of an AngleAxis is (cos a/2, sin a/2 axis); the products in the same order), so the
+// same bits.
+Quaterniond EulerToQuaternion(const EulerAngles& e, TrigMemo* memo) {
+  const auto of_axis = [memo](TrigMemo::Slot slot, double angle, const Vector3d& axis) {
+    double s, c;
+    memo->SinCos(slot, 0.5 * angle, &s, &c);
+    Quaterniond q;
+    q.w() = c;
+    q.vec() = s * axis;
+    return q;
+  };
+  return of_axis(TrigMemo::kHalfYaw, e.yaw_rad, Vector3d::UnitZ()) *
+         of_axis(TrigMemo::kHalfPitch, e.pitch_rad, Vector3d::UnitY()) *
+         of_axis(TrigMemo::kHalfRoll, e.roll_rad, Vector3d::UnitX());
+}
+
 // 4-point Gauss-Legendre nodes and weights on [-1, 1] (Abramowitz & Stegun, table 25.4).
 constexpr double kGaussNode[4] = {-0.861136311594052575224, -0.339981043584856264803,
                                   0.339981043584856264803, 0.861136311594052575224};
@@ -1492,7 +1510,7 @@ bool TrajectoryGenerator::Next(TrajectorySample* out) {
   out->truth.t_s = tb;
   out->truth.llh = Llh{m.llh.x(), WrapPi(m.llh.y()), m.llh.z()};
   out->truth.v_eb_n = k.v_eb_n;
-  out->truth.q_b_n = EulerToQuaternion(k.euler);
+  out->truth.q_b_n = EulerToQuaternion(k.euler, &m.trig_memo);
   m.PointSample(k, m.llh, &out->sample);
   return true;
 }
