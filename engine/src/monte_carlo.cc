@@ -6,12 +6,12 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_group.h>
 #include <tbb/task_arena.h>
 
 #include <exception>
 #include <memory>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -66,9 +66,9 @@ MonteCarloOutput RunMonteCarloWithAnalysis(
   // Mechanization A without a filter runs in lockstep groups (DRIFTLAB_ISA=scalar: one run at a
   // time, RunNed, kept as the reference the lockstep path must match bit for bit).
   const bool run_lockstep = !seed000 && !ekf && !complementary && !lockstep::ScalarForced();
-  // With two or more threads the lockstep runs start while the truth streams: this thread
-  // generates it while the others run the groups as far as it has come (the truth is the job's
-  // serial part: 5-20 % of a one-thread job). The same computations, so the same bits.
+  // With two or more threads the lockstep runs start while the truth streams: a thread of its own
+  // generates it while the `threads` workers run the groups as far as it has come (the truth is
+  // the job's serial part: 4-14 % of a one-thread job). The same computations, so the same bits.
   const bool overlap_truth = run_lockstep && threads >= 2 && !spec.covariance;
 
   SharedTruth shared;
@@ -135,30 +135,33 @@ MonteCarloOutput RunMonteCarloWithAnalysis(
   Monitor monitor(progress, cancel, run_count, samples_per_run * int64_t{run_count}, start);
   tbb::task_arena arena(threads);
   if (run_lockstep && overlap_truth) {
-    // The runs go to the arena's worker threads; this thread streams the truth and then joins
-    // them (task_arena + task_group: the arena keeps this thread's slot until it comes back).
+    // The truth streams on a thread of its own while all of the arena's `threads` slots (this
+    // thread and the workers) run the groups from the start, as far as the truth has come. (Until
+    // issue 17's last change this thread streamed the truth and joined the runs afterwards: its
+    // groups then started late by the truth's time, and the threads finished a group apart.)
     TruthStream stream;
-    tbb::task_group runs;
-    const lockstep::Kernel& kernel = lockstep::SelectKernel();
-    arena.execute([&] {
-      runs.run([&] {
+    std::exception_ptr truth_error;
+    std::thread truth_thread([&] {
+      try {
+        finish_truth(&stream);
+      } catch (...) {
+        truth_error = std::current_exception();
+      }
+      if (truth_error || cancelled_early) stream.Stop();
+    });
+    std::exception_ptr runs_error;
+    try {
+      const lockstep::Kernel& kernel = lockstep::SelectKernel();
+      arena.execute([&] {
         RunNedLockstep(truth, spec, kernel, gyrocompass, run_count, arena, accumulators,
                        checkpoint_values, &monitor, &stream);
       });
-    });
-    std::exception_ptr truth_error;
-    try {
-      finish_truth(&stream);
     } catch (...) {
-      truth_error = std::current_exception();
+      runs_error = std::current_exception();
     }
-    if (truth_error || cancelled_early) stream.Stop();
-    try {
-      arena.execute([&] { runs.wait(); });
-    } catch (...) {
-      if (!truth_error) throw;
-    }
+    truth_thread.join();
     if (truth_error) std::rethrow_exception(truth_error);
+    if (runs_error) std::rethrow_exception(runs_error);
     if (cancelled_early) return cancelled_during_truth();
   } else if (run_lockstep) {
     RunNedLockstep(truth, spec, lockstep::SelectKernel(), gyrocompass, run_count, arena,
