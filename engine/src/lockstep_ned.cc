@@ -3,6 +3,7 @@
 #include "lockstep_ned.h"
 
 #include <cstdlib>
+#include <stdexcept>
 #include <string>
 
 #include "driftlab/spec_error.h"

@@ -115,6 +115,28 @@ inline lane_math::U<W> MulLow32(lane_math::U<W> a, uint32_t m) {
   return a * static_cast<uint64_t>(m);
 }
 
+// The ten Philox rounds of Philox10 above on W counters at once, in 64-bit lanes holding 32-bit
+// words.
+template <int W>
+inline void PhiloxRoundsLanes(const uint32_t* key, lane_math::U<W>& c0, lane_math::U<W>& c1,
+                              lane_math::U<W>& c2, lane_math::U<W>& c3) {
+  using lane_math::U;
+  uint32_t k0 = key[0], k1 = key[1];
+#pragma GCC unroll 10
+  for (int round = 0; round < 10; ++round) {  // kPhiloxRounds (random.h)
+    if (round > 0) {
+      k0 += kPhiloxW0;
+      k1 += kPhiloxW1;
+    }
+    const U<W> p0 = MulLow32<W>(c0, kPhiloxM0);
+    const U<W> p1 = MulLow32<W>(c2, kPhiloxM1);
+    c0 = (p1 >> 32) ^ c1 ^ static_cast<uint64_t>(k0);
+    c1 = p1 & 0xffffffffu;
+    c2 = (p0 >> 32) ^ c3 ^ static_cast<uint64_t>(k1);
+    c3 = p0 & 0xffffffffu;
+  }
+}
+
 // Philox4x32-10 of the counters (block, run_word, stream_word) for W consecutive blocks, in
 // 64-bit lanes holding 32-bit words; the rounds of Philox10 above.
 template <int W>
@@ -131,19 +153,7 @@ inline void PhiloxLanes(const uint32_t* key, uint32_t run_word, uint32_t stream_
   U<W> c1 = blocks >> 32;
   U<W> c2 = U<W>{} + run_word;
   U<W> c3 = U<W>{} + stream_word;
-  uint32_t k0 = key[0], k1 = key[1];
-  for (int round = 0; round < 10; ++round) {  // kPhiloxRounds (random.h)
-    if (round > 0) {
-      k0 += kPhiloxW0;
-      k1 += kPhiloxW1;
-    }
-    const U<W> p0 = MulLow32<W>(c0, kPhiloxM0);
-    const U<W> p1 = MulLow32<W>(c2, kPhiloxM1);
-    c0 = (p1 >> 32) ^ c1 ^ static_cast<uint64_t>(k0);
-    c1 = p1 & 0xffffffffu;
-    c2 = (p0 >> 32) ^ c3 ^ static_cast<uint64_t>(k1);
-    c3 = p0 & 0xffffffffu;
-  }
+  PhiloxRoundsLanes<W>(key, c0, c1, c2, c3);
   if constexpr (W == 1) {
     x[0][b] = static_cast<uint32_t>(c0);
     x[1][b] = static_cast<uint32_t>(c1);
@@ -249,20 +259,7 @@ inline void GaussianAcrossRuns(const uint32_t* key, const uint32_t* run_words, u
         U<W> c1 = U<W>{} + (block >> 32);
         U<W> c2 = run[g];
         U<W> c3 = U<W>{} + stream_word;
-        uint32_t k0 = key[0], k1 = key[1];
-#pragma GCC unroll 10
-        for (int round = 0; round < 10; ++round) {  // kPhiloxRounds (random.h)
-          if (round > 0) {
-            k0 += kPhiloxW0;
-            k1 += kPhiloxW1;
-          }
-          const U<W> p0 = MulLow32<W>(c0, kPhiloxM0);
-          const U<W> p1 = MulLow32<W>(c2, kPhiloxM1);
-          c0 = (p1 >> 32) ^ c1 ^ static_cast<uint64_t>(k0);
-          c1 = p1 & 0xffffffffu;
-          c2 = (p0 >> 32) ^ c3 ^ static_cast<uint64_t>(k1);
-          c3 = p0 & 0xffffffffu;
-        }
+        PhiloxRoundsLanes<W>(key, c0, c1, c2, c3);
         words[b][g][0] = c0;
         words[b][g][1] = c1;
         words[b][g][2] = c2;
