@@ -95,9 +95,9 @@ using AdvanceFn = void (*)(const KernelJob& job, const KernelInputs& in, int64_t
 using FillFn = void (*)(const uint32_t* key, uint32_t run_word, uint32_t stream_word,
                         uint64_t first_index, double* out, int count);
 
-// N(0, 1) deviates of the kMaxLanes streams (key[2], run_words[lane], stream_word), blocks
-// [block0, block0 + nblocks): deviate 4 b + i of lane l into out[4 (b - block0) + i][l]
-// (random_kernels::GaussianAcrossRuns, the same numbers as FillFn's).
+// N(0, 1) deviates of the streams (key[2], run_words[lane], stream_word) of the kernel's lanes
+// (its width: 4 or 8), blocks [block0, block0 + nblocks): deviate 4 b + i of lane l into
+// out[4 (b - block0) + i][l] (random_kernels::GaussianAcrossRuns, the same numbers as FillFn's).
 using FillLanesFn = void (*)(const uint32_t* key, const uint32_t* run_words, uint32_t stream_word,
                              uint64_t block0, int nblocks, double (*out)[kMaxLanes]);
 

@@ -19,7 +19,7 @@ void Fill(const uint32_t* key, uint32_t run_word, uint32_t stream_word, uint64_t
 void FillLanes(const uint32_t* key, const uint32_t* run_words, uint32_t stream_word,
                uint64_t block0, int nblocks, double (*out)[kMaxLanes]) {
   random_kernels::GaussianAcrossRuns<2, 4, kMaxLanes>(key, run_words, stream_word, block0, nblocks,
-                                                    &out[0][0]);
+                                                      &out[0][0]);
 }
 }  // namespace
 

@@ -334,9 +334,10 @@ struct Kernel {
     const V3 u = Rotate(q, delta_v_b);
     const V3 first_order = Sub(Add(u, Rotate(q, second_order_b)), Scale(0.5, Cross(zeta, u)));
     const V3 delta_v_sf_n =
-        kPredictor ? first_order
-                   : Add(Sub(first_order, Scale(Cross(zeta, Rotate(q, alpha_cross_dv)), kOneTwelfth)),
-                         Scale(Cross(zeta, Cross(zeta, u)), kOneSixth));
+        kPredictor
+            ? first_order
+            : Add(Sub(first_order, Scale(Cross(zeta, Rotate(q, alpha_cross_dv)), kOneTwelfth)),
+                  Scale(Cross(zeta, Cross(zeta, u)), kOneSixth));
     // Gravity and Coriolis at the midpoint:
     //   v(k+1) = v(k) + delta_v_sf_n + (g_b_n - (omega_en_n + 2 omega_ie_n) x v_eb_n)(mid) dt
     //                                                                                 Groves (5.54)
@@ -402,13 +403,13 @@ struct Kernel {
     const Lat lat = LatOf(L);
     const V3 llh_rate_old = LlhRate(job.earth, lat, h, v);
     const V3 llh_rate_mid = LlhRate(job.earth, lat, h, v_mid_predicted);
-    const Step predicted =
-        Propagate<true>(job, q, lat, lon, h, v, delta_v_b, alpha_cross_dv, second_order_b, llh_rate_old,
-                  L + 0.5 * dt * llh_rate_mid.x, h + 0.5 * dt * llh_rate_mid.z, v_mid_predicted);
+    const Step predicted = Propagate<true>(
+        job, q, lat, lon, h, v, delta_v_b, alpha_cross_dv, second_order_b, llh_rate_old,
+        L + 0.5 * dt * llh_rate_mid.x, h + 0.5 * dt * llh_rate_mid.z, v_mid_predicted);
     // Corrector: midpoint quantities as averages of the old and the predicted new state.
-    const Step corrected = Propagate<false>(job, q, lat, lon, h, v, delta_v_b, alpha_cross_dv,
-                                     second_order_b, llh_rate_old, 0.5 * (L + predicted.L),
-                                     0.5 * (h + predicted.h), Scale(0.5, Add(v, predicted.v)));
+    const Step corrected = Propagate<false>(
+        job, q, lat, lon, h, v, delta_v_b, alpha_cross_dv, second_order_b, llh_rate_old,
+        0.5 * (L + predicted.L), 0.5 * (h + predicted.h), Scale(0.5, Add(v, predicted.v)));
     // Attitude: C_b_n(k+1) = C_n(k)_n(k+1) C_b_n(k) C_b(k+1)_b(k), each factor the exact rotation
     // of its rotation vector:  q_b_n(k+1) = q(-zeta) q_b_n(k) q(alpha).                Groves
     // (5.75)

@@ -38,10 +38,10 @@ using mc_detail::RunNed;
 using mc_detail::RunNedLockstep;
 using mc_detail::RunSeed000;
 using mc_detail::RunSink;
-using mc_detail::StreamSharedTruth;
-using mc_detail::TruthStream;
 using mc_detail::Seconds;
 using mc_detail::SharedTruth;
+using mc_detail::StreamSharedTruth;
+using mc_detail::TruthStream;
 using mc_detail::UseGyrocompass;
 
 MonteCarloStatistics RunMonteCarlo(const MonteCarloSpec& spec,

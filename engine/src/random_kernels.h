@@ -226,11 +226,11 @@ inline void UniformChunk(const uint32_t* key, uint32_t run_word, uint32_t stream
 
 // Deviates of several runs at once (the lockstep kernels): the streams (key, run_words[lane],
 // stream_word) of kLanes runs that differ only in their run word, blocks [block0, block0 +
-// nblocks), deviate 4 b + i of lane l into out[(4 (b - block0) + i) * kLanes + l], i.e. rows of
-// one sample for all lanes, the layout the kernels read. W lanes per vector: Philox and
-// Box-Muller across runs rather than across blocks, so each row is one vector store (no
-// interleaving of the four words of a block, no copy). The same operations on each lane as
-// GaussianChunk: the same bits.
+// nblocks), deviate 4 b + i of lane l into out[(4 (b - block0) + i) * kRowStride + l], i.e. rows
+// of one sample for all lanes, the layout the kernels read (kRowStride = kMaxLanes). W lanes per
+// vector: Philox and Box-Muller across runs rather than across blocks, so each row is one vector
+// store (no interleaving of the four words of a block, no copy). The same operations on each lane
+// as GaussianChunk: the same bits.
 template <int W, int kLanes, int kRowStride>
 inline void GaussianAcrossRuns(const uint32_t* key, const uint32_t* run_words, uint32_t stream_word,
                                uint64_t block0, int nblocks, double* out) {

@@ -105,8 +105,15 @@ struct Ramp {
 // per generator (TrajectoryGenerator::Next's path only; the const queries pass none).
 class TrigMemo {
  public:
-  enum Slot { kTrack = 0, kRoll = 1, kPitch = 2, kYaw = 3, kHalfRoll = 4, kHalfPitch = 5,
-              kHalfYaw = 6 };
+  enum Slot {
+    kTrack = 0,
+    kRoll = 1,
+    kPitch = 2,
+    kYaw = 3,
+    kHalfRoll = 4,
+    kHalfPitch = 5,
+    kHalfYaw = 6
+  };
   void SinCos(Slot slot, double x, double* s, double* c) {
     Entry& e = entries_[slot];
     const uint64_t bits = std::bit_cast<uint64_t>(x);
