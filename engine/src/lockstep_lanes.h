@@ -89,21 +89,15 @@ struct KernelInputs {
 using AdvanceFn = void (*)(const KernelJob& job, const KernelInputs& in, int64_t k_begin,
                            int64_t k_end, bool navigate, LockstepGroup* group);
 
-// N(0, 1) deviates first_index .. first_index + count - 1 of the stream (key[2], run_word,
-// stream_word): RandomStream::FillGaussian's code (random_kernels.h) built for the kernel's
-// instruction set.
-using FillFn = void (*)(const uint32_t* key, uint32_t run_word, uint32_t stream_word,
-                        uint64_t first_index, double* out, int count);
-
 // N(0, 1) deviates of the streams (key[2], run_words[lane], stream_word) of the kernel's lanes
 // (its width: 4 or 8), blocks [block0, block0 + nblocks): deviate 4 b + i of lane l into
-// out[4 (b - block0) + i][l] (random_kernels::GaussianAcrossRuns, the same numbers as FillFn's).
+// out[4 (b - block0) + i][l] (random_kernels::GaussianAcrossRuns built for the kernel's
+// instruction set: the numbers of RandomStream::FillGaussian).
 using FillLanesFn = void (*)(const uint32_t* key, const uint32_t* run_words, uint32_t stream_word,
                              uint64_t block0, int nblocks, double (*out)[kMaxLanes]);
 
 struct KernelEntry {
   AdvanceFn advance = nullptr;
-  FillFn fill = nullptr;
   FillLanesFn fill_lanes = nullptr;
 };
 

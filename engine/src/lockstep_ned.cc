@@ -136,6 +136,23 @@ void SetNavLane(const NavState& initial, int lane, LockstepGroup* group) {
   n.t0_s = initial.t_s;
 }
 
+namespace {
+
+// The run words of the streams r[0 .. kMaxLanes) of a group's lanes for Kernel::fill_lanes:
+// they differ only in their run word (same seed, same stream); lanes past `lanes` repeat lane 0's
+// (their numbers are not used).
+void LaneRunWords(const RandomStream* r, int lanes, uint32_t (&run_words)[kMaxLanes]) {
+  for (int lane = 0; lane < kMaxLanes; ++lane) {
+    const RandomStream& rl = r[lane < lanes ? lane : 0];
+    if (rl.key() != r[0].key() || rl.stream_word() != r[0].stream_word()) {
+      throw std::logic_error("lockstep: the lanes of a group draw from different streams");
+    }
+    run_words[lane] = rl.run_word();
+  }
+}
+
+}  // namespace
+
 void LoadBlock(const LockstepJob& job, const Kernel& kernel, int64_t block_begin,
                GroupStreams* streams, LockstepGroup* group) {
   if (!job.kernel.has_sensor) return;
@@ -148,17 +165,9 @@ void LoadBlock(const LockstepJob& job, const Kernel& kernel, int64_t block_begin
       if (!TermOn(p, term)) continue;
       double(*dst)[kBlock][kMaxLanes] = PerSampleBuffer(lanes, term);
       for (int axis = 0; axis < 3; ++axis) {
-        // The lanes' streams differ only in their run word (same seed, same stream); lanes past
-        // group->lanes repeat lane 0's (their numbers are not used).
         const RandomStream* r = streams->per_sample[t][term][axis];
         uint32_t run_words[kMaxLanes];
-        for (int lane = 0; lane < kMaxLanes; ++lane) {
-          const RandomStream& rl = r[lane < group->lanes ? lane : 0];
-          if (rl.key() != r[0].key() || rl.stream_word() != r[0].stream_word()) {
-            throw std::logic_error("lockstep: the lanes of a group draw from different streams");
-          }
-          run_words[lane] = rl.run_word();
-        }
+        LaneRunWords(r, group->lanes, run_words);
         kernel.fill_lanes(r[0].key().data(), run_words, r[0].stream_word(), b0 / 4, kBlock / 4,
                           dst[axis]);
       }
@@ -175,31 +184,31 @@ void LoadBlock(const LockstepJob& job, const Kernel& kernel, int64_t block_begin
       // Deviates [first, first + count) of the component's streams, from its window.
       const uint64_t first = (from >> m) - 1;
       constexpr int kWindow = GroupStreams::kFlickerWindow;
+      constexpr int kRows = GroupStreams::kFlickerWindowRows;
       static_assert(kWindow >= kBlock, "a window holds at least one block's deviates");
       uint64_t& window_first = streams->flicker_window_first[t][j];
       int& valid = streams->flicker_window_valid[t][j];
-      if (!valid || first < window_first || first + count > window_first + kWindow) {
+      if (!valid || first < window_first || first + count > window_first + kRows) {
         if (streams->flicker_window.empty()) {
-          streams->flicker_window.resize(
-              static_cast<size_t>(2 * kMaxFlicker * 3 * kMaxLanes * kWindow));
+          streams->flicker_window.resize(static_cast<size_t>(2 * kMaxFlicker * 3 * kRows) *
+                                         kMaxLanes);
         }
+        window_first = first & ~uint64_t{3};  // the Philox block of deviate `first`
         for (int axis = 0; axis < 3; ++axis) {
-          for (int lane = 0; lane < group->lanes; ++lane) {
-            const RandomStream& r = streams->Flicker(t, axis, j, lane);
-            kernel.fill(r.key().data(), r.run_word(), r.stream_word(), first,
-                        streams->FlickerWindow(t, j, axis, lane), kWindow);
-          }
+          const RandomStream* r = &streams->Flicker(t, axis, j, 0);
+          uint32_t run_words[kMaxLanes];
+          LaneRunWords(r, group->lanes, run_words);
+          kernel.fill_lanes(r[0].key().data(), run_words, r[0].stream_word(), window_first / 4,
+                            kRows / 4, streams->FlickerWindow(t, j, axis));
         }
-        window_first = first;
         valid = 1;
       }
       const size_t offset = static_cast<size_t>(first - window_first);
       for (int axis = 0; axis < 3; ++axis) {
-        for (int lane = 0; lane < group->lanes; ++lane) {
-          const double* w = streams->FlickerWindow(t, j, axis, lane) + offset;
-          for (size_t c = 0; c < count; ++c) {
-            lanes.flicker_w[axis][j][((from - b0) >> m) + c][lane] = w[c];
-          }
+        const double(*w)[kMaxLanes] = streams->FlickerWindow(t, j, axis) + offset;
+        for (size_t c = 0; c < count; ++c) {
+          __builtin_memcpy(lanes.flicker_w[axis][j][((from - b0) >> m) + c], w[c],
+                           sizeof(double) * kMaxLanes);
         }
       }
     }
@@ -261,7 +270,6 @@ Kernel KernelFor(Isa isa) {
       break;
   }
   k.advance = entry.advance;
-  k.fill = entry.fill;
   k.fill_lanes = entry.fill_lanes;
   return k;
 }

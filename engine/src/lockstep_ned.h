@@ -43,7 +43,6 @@ struct Kernel {
   Isa isa = Isa::kBaseline;
   int width = 2;  // lanes per group
   AdvanceFn advance = nullptr;
-  FillFn fill = nullptr;
   FillLanesFn fill_lanes = nullptr;
   const char* name = "baseline";
 };
@@ -83,19 +82,22 @@ struct GroupStreams {
   RandomStream& Flicker(int triad, int axis, int j, int lane) {
     return flicker[static_cast<size_t>(((triad * 3 + axis) * kMaxFlicker + j) * kMaxLanes + lane)];
   }
-  // A window of kFlickerWindow deviates per flicker stream, filled in one call and used by the
-  // blocks that need them: a component updated every 2^m samples needs only kBlock >> m deviates
-  // a block, and small fills cost more in call overhead than in arithmetic (tactical preset,
-  // 7 components: ~half its deviate time). Windows of [triad][component] start at the same
-  // deviate index for every axis and lane; StartSensorLane invalidates them (new streams).
+  // A window of deviates per flicker stream, filled in one call for all lanes (Kernel::fill_lanes,
+  // rows of lanes) and used by the blocks that need them: a component updated every 2^m samples
+  // needs only kBlock >> m deviates a block, and small fills cost more in call overhead than in
+  // arithmetic (tactical preset, 7 components: ~half its deviate time). A window covers
+  // kFlickerWindow deviates from flicker_window_first (the Philox block holding the first one: up
+  // to 3 more rows before it); windows of [triad][component] start at the same deviate index for
+  // every axis; StartSensorLane invalidates them (new streams).
   static constexpr int kFlickerWindow = 128;
-  std::vector<double> flicker_window;  // [triad][component][axis][lane][kFlickerWindow]
-  uint64_t flicker_window_first[2][kMaxFlicker] = {};
+  static constexpr int kFlickerWindowRows = kFlickerWindow + 4;
+  std::vector<double> flicker_window;                  // [triad][component][axis][row][kMaxLanes]
+  uint64_t flicker_window_first[2][kMaxFlicker] = {};  // deviate index of row 0 (a multiple of 4)
   int flicker_window_valid[2][kMaxFlicker] = {};
-  double* FlickerWindow(int triad, int j, int axis, int lane) {
-    return flicker_window.data() +
-           static_cast<size_t>(((triad * kMaxFlicker + j) * 3 + axis) * kMaxLanes + lane) *
-               kFlickerWindow;
+  double (*FlickerWindow(int triad, int j, int axis))[kMaxLanes] {
+    return reinterpret_cast<double(*)[kMaxLanes]>(
+        flicker_window.data() +
+        static_cast<size_t>((triad * kMaxFlicker + j) * 3 + axis) * kFlickerWindowRows * kMaxLanes);
   }
 };
 

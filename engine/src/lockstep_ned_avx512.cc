@@ -12,11 +12,6 @@ void Advance8(const KernelJob& job, const KernelInputs& in, int64_t k_begin, int
               bool navigate, LockstepGroup* group) {
   Kernel<8>::Advance(job, in, k_begin, k_end, navigate, group);
 }
-void Fill(const uint32_t* key, uint32_t run_word, uint32_t stream_word, uint64_t first_index,
-          double* out, int count) {
-  random_kernels::FillGaussianRange(key, run_word, stream_word, first_index, out,
-                                    static_cast<size_t>(count));
-}
 void FillLanes(const uint32_t* key, const uint32_t* run_words, uint32_t stream_word,
                uint64_t block0, int nblocks, double (*out)[kMaxLanes]) {
   random_kernels::GaussianAcrossRuns<8, 8, kMaxLanes>(key, run_words, stream_word, block0, nblocks,
@@ -24,7 +19,7 @@ void FillLanes(const uint32_t* key, const uint32_t* run_words, uint32_t stream_w
 }
 }  // namespace
 
-KernelEntry EntryAvx512() { return {&Advance8, &Fill, &FillLanes}; }
+KernelEntry EntryAvx512() { return {&Advance8, &FillLanes}; }
 #else
 KernelEntry EntryAvx512() { return {}; }
 #endif
