@@ -241,18 +241,25 @@ Vector3d NavEnvironment::LlhRate(const Latitude& lat, double h_b, const Vector3d
 }
 
 Vector3d NavEnvironment::PositionErrorNed(const Llh& estimate, const Llh& truth) const {
+  return PositionErrorNed(estimate, truth, PositionScaleAt(truth));
+}
+
+NavEnvironment::PositionScale NavEnvironment::PositionScaleAt(const Llh& truth) const {
+  if (model_ == EarthModel::kFlat) return {flat_R_N_m_, flat_R_E_m_, 1.0};
+  // First-order curvilinear-to-metre scaling, Groves (2.119); exact to ~1e-7 relative for the
+  // position errors of interest (< 100 km).
+  return {MeridianRadius(truth.lat_rad) + truth.h_m, TransverseRadius(truth.lat_rad) + truth.h_m,
+          Cos(truth.lat_rad)};
+}
+
+Vector3d NavEnvironment::PositionErrorNed(const Llh& estimate, const Llh& truth,
+                                          const PositionScale& scale) const {
   const double dL = estimate.lat_rad - truth.lat_rad;
   double dlambda = estimate.lon_rad - truth.lon_rad;
   dlambda = std::remainder(dlambda, 2.0 * M_PI);
   const double dh = estimate.h_m - truth.h_m;
-  if (model_ == EarthModel::kFlat) {
-    return Vector3d(dL * flat_R_N_m_, dlambda * flat_R_E_m_, -dh);
-  }
-  // First-order curvilinear-to-metre scaling, Groves (2.119); exact to ~1e-7 relative for the
-  // position errors of interest (< 100 km).
-  return Vector3d(dL * (MeridianRadius(truth.lat_rad) + truth.h_m),
-                  dlambda * (TransverseRadius(truth.lat_rad) + truth.h_m) * Cos(truth.lat_rad),
-                  -dh);
+  // Flat: cos_L = 1, a product that changes nothing.
+  return Vector3d(dL * scale.north_m, dlambda * scale.east_m * scale.cos_L, -dh);
 }
 
 }  // namespace driftlab

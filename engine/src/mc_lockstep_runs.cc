@@ -41,11 +41,12 @@ bool RunNedGroup(const SharedTruth& s, const MonteCarloSpec& spec, const lockste
   size_t next = 0;
   const size_t n_reports = s.reports.size();
   auto record = [&](const Report& r) {
+    const NavErrorTruth truth_terms(s.env, r.truth);  // once for the group's lanes
     for (int lane = 0; lane < lanes; ++lane) {
       RunSink lane_sink = sink;
       lane_sink.slot = slot_begin + static_cast<uint32_t>(lane);
       lane_sink.Record(
-          r, ComputeNavError(s.env, lockstep::NavStateOfLane(*group, s.dt_s, lane), r.truth));
+          r, ComputeNavError(s.env, lockstep::NavStateOfLane(*group, s.dt_s, lane), truth_terms));
     }
   };
   // Navigation starts at s0 from the alignment sums of k = 1..s0 (RunNed).
@@ -57,8 +58,8 @@ bool RunNedGroup(const SharedTruth& s, const MonteCarloSpec& spec, const lockste
       const Eigen::Vector3d sum_dtheta(n.sum_dtheta[0][lane], n.sum_dtheta[1][lane],
                                        n.sum_dtheta[2][lane]);
       const Eigen::Vector3d sum_dv(n.sum_dv[0][lane], n.sum_dv[1][lane], n.sum_dv[2][lane]);
-      lockstep::SetNavLane(NedStartState(s, spec, run, use_gyrocompass, sum_dtheta, sum_dv),
-                           lane, group);
+      lockstep::SetNavLane(NedStartState(s, spec, run, use_gyrocompass, sum_dtheta, sum_dv), lane,
+                           group);
     }
     if (s.reports[0].k == s.start_step) {
       record(s.reports[0]);

@@ -118,6 +118,14 @@ class NavEnvironment {
   // Position error of `estimate` relative to `truth`, in metres along N, E, D at the truth point,
   // using the curvilinear-to-metre scaling of this environment.
   Vector3d PositionErrorNed(const Llh& estimate, const Llh& truth) const;
+  // That scaling at a truth point, for many estimates against one truth (the same operations as
+  // PositionErrorNed(estimate, truth), so the same bits): dL (R_N + h), dlambda (R_E + h) cos L.
+  struct PositionScale {
+    double north_m = 0.0, east_m = 0.0, cos_L = 1.0;  // flat: its radii and 1
+  };
+  PositionScale PositionScaleAt(const Llh& truth) const;
+  Vector3d PositionErrorNed(const Llh& estimate, const Llh& truth,
+                            const PositionScale& scale) const;
 
  private:
   EarthModel model_ = EarthModel::kWgs84;

@@ -45,4 +45,19 @@ struct NavError {
 NavError ComputeNavError(const NavEnvironment& env, const NavState& estimate,
                          const NavState& truth);
 
+// The truth's share of ComputeNavError (its position scaling, Euler angles and C_b_n), computed
+// once for many estimates against one truth (the runs of a lockstep group at a report):
+// ComputeNavError(env, estimate, NavErrorTruth(env, truth)) performs the operations of
+// ComputeNavError(env, estimate, truth), so it gives the same bits.
+struct NavErrorTruth {
+  NavErrorTruth(const NavEnvironment& env, const NavState& truth);
+  Llh llh;
+  Vector3d v_eb_n;
+  NavEnvironment::PositionScale position_scale;
+  EulerAngles euler;
+  Matrix3d C_b_n;
+};
+NavError ComputeNavError(const NavEnvironment& env, const NavState& estimate,
+                         const NavErrorTruth& truth);
+
 }  // namespace driftlab
