@@ -122,6 +122,31 @@ TEST(ExactSumTest, TruncatesBelowLowestBinAndCountsOverflow) {
   EXPECT_EQ(square.Value(), std::numeric_limits<long double>::infinity());
 }
 
+// Values below 2^-60 keep only their bits from 2^-112 up, truncated toward zero whatever the
+// sign (exact_sum.h); the expected sums are exact dyadic numbers, computed by hand.
+TEST(ExactSumTest, TruncatesBitsBelowLowestBinTowardZeroForBothSigns) {
+  const double x = 0x1p-100 + 0x1p-152;  // 2^-100 (1 + 2^-52): its last bit is below 2^-112
+  ExactSum s;
+  for (int i = 0; i < 3; ++i) s.Add(x);
+  EXPECT_EQ(s.Value(), 3.0L * 0x1p-100L);
+  s.Add(-x);  // -(2^-100), not -(2^-100 + 2^-112)
+  EXPECT_EQ(s.Value(), 2.0L * 0x1p-100L);
+  s.Add(-0x1p-176);  // 64 binades below 2^-112 and lower: nothing left
+  s.Add(0x1p-1000);
+  EXPECT_EQ(s.Value(), 2.0L * 0x1p-100L);
+  ExactSum mixed;  // bits at 2^-111 >= 2^-112 are kept exactly, for either sign
+  mixed.Add(-(0x1p-70 + 0x1p-111));
+  mixed.Add(0x1p-111);
+  EXPECT_EQ(mixed.Value(), -0x1p-70L);
+  mixed.Add(1.5 * 0x1p-70);
+  EXPECT_EQ(mixed.Value(), 0x1p-71L);
+  ExactSum neg;  // the same magnitudes with every sign flipped give the negated state
+  for (int i = 0; i < 3; ++i) neg.Add(-x);
+  neg.Add(x);
+  neg.Add(0x1p-176);
+  EXPECT_EQ(neg.Value(), -2.0L * 0x1p-100L);
+}
+
 TEST(ExactSumTest, SerializationRoundTripsAndRejectsMalformedState) {
   const ExactSum s = SumOf(WideValues(100, 6, false));
   const std::vector<int64_t> data = s.Serialize();

@@ -45,32 +45,25 @@ void ExactSum::AddFinite(double x) {
   const int biased_exponent = static_cast<int>(bits >> 52);
   if (biased_exponent == 0) return;  // subnormal: entirely below 2^-112, truncated to zero
   uint64_t mantissa = (bits & ((uint64_t{1} << 52) - 1)) | (uint64_t{1} << 52);
-  // Position of the mantissa's bit 0 above the accumulator's bit 0 (weight 2^-112).
-  int shift = biased_exponent - 1075 - kLowestExponent;
-  if (shift < 0) {
-    if (shift <= -64) return;  // entirely below 2^-112: truncated to zero
-    mantissa >>= -shift;       // truncation toward zero of the bits below 2^-112
-    shift = 0;
-    if (mantissa == 0) return;
-  }
+  // Position of the mantissa's bit 0 above the accumulator's bit 0 (weight 2^-112). Below it
+  // (shift < 0) the bits under 2^-112 are truncated toward zero: mantissa >> -shift, nothing left
+  // from -shift >= 64. Written with selects rather than branches: the sign and the small values
+  // (the rounding errors of AddSquare) change from one added value to the next.
+  const int shift_raw = biased_exponent - 1075 - kLowestExponent;
+  const int down = shift_raw < 0 ? -shift_raw : 0;
+  mantissa = down < 64 ? mantissa >> down : 0;
+  const int shift = shift_raw < 0 ? 0 : shift_raw;
   // shift <= 96 - 53 + 112 = 155, so j0 <= 4 and the three chunks land in bins j0..j0+2 <= 6.
   const int j0 = shift / kChunkBits;
   const int r = shift % kChunkBits;
   const uint64_t lo = (mantissa & kChunkMask) << r;   // < 2^63
   const uint64_t hi = (mantissa >> kChunkBits) << r;  // < 2^52
   const uint64_t t = (lo >> kChunkBits) + hi;         // < 2^53
-  const int64_t c0 = static_cast<int64_t>(lo & kChunkMask);
-  const int64_t c1 = static_cast<int64_t>(t & kChunkMask);
-  const int64_t c2 = static_cast<int64_t>(t >> kChunkBits);
-  if (x > 0.0) {
-    bins_[j0] += c0;
-    bins_[j0 + 1] += c1;
-    bins_[j0 + 2] += c2;
-  } else {
-    bins_[j0] -= c0;
-    bins_[j0 + 1] -= c1;
-    bins_[j0 + 2] -= c2;
-  }
+  // The sign as 0 or -1: (c ^ sign) - sign is c or -c. (A value truncated to zero adds zeros.)
+  const int64_t sign = static_cast<int64_t>(std::bit_cast<uint64_t>(x)) >> 63;
+  bins_[j0] += (static_cast<int64_t>(lo & kChunkMask) ^ sign) - sign;
+  bins_[j0 + 1] += (static_cast<int64_t>(t & kChunkMask) ^ sign) - sign;
+  bins_[j0 + 2] += (static_cast<int64_t>(t >> kChunkBits) ^ sign) - sign;
   if (++pending_ >= kMaxPending) {
     Normalize(&bins_);
     pending_ = 0;
