@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "lane_math.h"
+#include "nav_error_lanes.h"
 
 namespace driftlab {
 
@@ -36,11 +37,13 @@ Matrix3d EulerToDcm(const EulerTrig& t) {
 }
 
 EulerAngles DcmToEuler(const Matrix3d& C_b_n) {
-  EulerAngles e;
-  e.roll_rad = std::atan2(C_b_n(2, 1), C_b_n(2, 2));
-  e.pitch_rad = -std::asin(std::clamp(C_b_n(2, 0), -1.0, 1.0));
-  e.yaw_rad = std::atan2(C_b_n(1, 0), C_b_n(0, 0));
-  return e;
+  double e[3];  // the lockstep kernels' code at one lane (nav_error_lanes.h)
+  nav_error_lanes::EulerOfDcm<1>(C_b_n(0, 0), C_b_n(1, 0), C_b_n(2, 0), C_b_n(2, 1), C_b_n(2, 2), e);
+  EulerAngles out;
+  out.roll_rad = e[0];
+  out.pitch_rad = e[1];
+  out.yaw_rad = e[2];
+  return out;
 }
 
 Matrix3d RotationVectorToDcm(const Vector3d& rho) {
@@ -97,14 +100,7 @@ Vector3d EulerRatesToBodyRate(const EulerTrig& t, const Vector3d& euler_rates) {
   return Vector3d(droll - dyaw * st, dpitch * cp + dyaw * ct * sp, -dpitch * sp + dyaw * ct * cp);
 }
 
-double WrapPi(double angle_rad) {
-  // Already in (-pi, pi]: remainder would return it unchanged (its quotient |x / 2pi| <= 1/2
-  // rounds to 0, a tie to even), so skip the library call.
-  if (angle_rad > -M_PI && angle_rad <= M_PI) return angle_rad;
-  double w = std::remainder(angle_rad, 2.0 * M_PI);
-  if (w <= -M_PI) w += 2.0 * M_PI;
-  return w;
-}
+double WrapPi(double angle_rad) { return nav_error_lanes::WrapPiOf(angle_rad); }
 
 Vector3d EulerDifference(const EulerAngles& estimate, const EulerAngles& truth) {
   return Vector3d(WrapPi(estimate.roll_rad - truth.roll_rad),

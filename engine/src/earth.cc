@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "lane_math.h"
+#include "nav_error_lanes.h"
 
 namespace driftlab {
 
@@ -254,12 +255,11 @@ NavEnvironment::PositionScale NavEnvironment::PositionScaleAt(const Llh& truth) 
 
 Vector3d NavEnvironment::PositionErrorNed(const Llh& estimate, const Llh& truth,
                                           const PositionScale& scale) const {
-  const double dL = estimate.lat_rad - truth.lat_rad;
-  double dlambda = estimate.lon_rad - truth.lon_rad;
-  dlambda = std::remainder(dlambda, 2.0 * M_PI);
-  const double dh = estimate.h_m - truth.h_m;
-  // Flat: cos_L = 1, a product that changes nothing.
-  return Vector3d(dL * scale.north_m, dlambda * scale.east_m * scale.cos_L, -dh);
+  double r[3];  // the lockstep kernels' code at one lane (nav_error_lanes.h)
+  nav_error_lanes::PositionError<1>(estimate.lat_rad, estimate.lon_rad, estimate.h_m, truth.lat_rad,
+                                    truth.lon_rad, truth.h_m, scale.north_m, scale.east_m,
+                                    scale.cos_L, r);
+  return Vector3d(r[0], r[1], r[2]);
 }
 
 }  // namespace driftlab

@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "driftlab/triad_step_params.h"
+#include "nav_error_lanes.h"
 
 namespace driftlab::lockstep {
 
@@ -96,9 +97,15 @@ using AdvanceFn = void (*)(const KernelJob& job, const KernelInputs& in, int64_t
 using FillLanesFn = void (*)(const uint32_t* key, const uint32_t* run_words, uint32_t stream_word,
                              uint64_t block0, int nblocks, double (*out)[kMaxLanes]);
 
+// The error components (nav_error_lanes::ErrorComponents, in ErrorComponent order) of all the
+// kernel's lanes of `nav` against one truth: component c of lane l into out[c][l].
+using ErrorsFn = void (*)(const nav_error_lanes::TruthTerms& truth, const NavLanes& nav,
+                          double (*out)[kMaxLanes]);
+
 struct KernelEntry {
   AdvanceFn advance = nullptr;
   FillLanesFn fill_lanes = nullptr;
+  ErrorsFn errors = nullptr;
 };
 
 // Per-ISA entry points (defined in lockstep_ned_<isa>.cc; null where the build or the

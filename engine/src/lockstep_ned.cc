@@ -271,6 +271,7 @@ Kernel KernelFor(Isa isa) {
   }
   k.advance = entry.advance;
   k.fill_lanes = entry.fill_lanes;
+  k.errors = entry.errors;
   return k;
 }
 

@@ -44,6 +44,7 @@ struct Kernel {
   int width = 2;  // lanes per group
   AdvanceFn advance = nullptr;
   FillLanesFn fill_lanes = nullptr;
+  ErrorsFn errors = nullptr;
   const char* name = "baseline";
 };
 

@@ -17,9 +17,13 @@ void FillLanes(const uint32_t* key, const uint32_t* run_words, uint32_t stream_w
   random_kernels::GaussianAcrossRuns<4, 4, kMaxLanes>(key, run_words, stream_word, block0, nblocks,
                                                       &out[0][0]);
 }
+void Errors(const nav_error_lanes::TruthTerms& truth, const NavLanes& nav,
+            double (*out)[kMaxLanes]) {
+  Kernel<4>::Errors(truth, nav, out);
+}
 }  // namespace
 
-KernelEntry EntryAvx2() { return {&Advance4, &FillLanes}; }
+KernelEntry EntryAvx2() { return {&Advance4, &FillLanes, &Errors}; }
 #else
 KernelEntry EntryAvx2() { return {}; }
 #endif

@@ -17,9 +17,13 @@ void FillLanes(const uint32_t* key, const uint32_t* run_words, uint32_t stream_w
   random_kernels::GaussianAcrossRuns<8, 8, kMaxLanes>(key, run_words, stream_word, block0, nblocks,
                                                       &out[0][0]);
 }
+void Errors(const nav_error_lanes::TruthTerms& truth, const NavLanes& nav,
+            double (*out)[kMaxLanes]) {
+  Kernel<8>::Errors(truth, nav, out);
+}
 }  // namespace
 
-KernelEntry EntryAvx512() { return {&Advance8, &FillLanes}; }
+KernelEntry EntryAvx512() { return {&Advance8, &FillLanes, &Errors}; }
 #else
 KernelEntry EntryAvx512() { return {}; }
 #endif

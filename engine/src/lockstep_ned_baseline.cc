@@ -16,8 +16,12 @@ void FillLanes(const uint32_t* key, const uint32_t* run_words, uint32_t stream_w
   random_kernels::GaussianAcrossRuns<2, 4, kMaxLanes>(key, run_words, stream_word, block0, nblocks,
                                                       &out[0][0]);
 }
+void Errors(const nav_error_lanes::TruthTerms& truth, const NavLanes& nav,
+            double (*out)[kMaxLanes]) {
+  Kernel<4>::Errors(truth, nav, out);
+}
 }  // namespace
 
-KernelEntry EntryBaseline() { return {&Advance4, &FillLanes}; }
+KernelEntry EntryBaseline() { return {&Advance4, &FillLanes, &Errors}; }
 
 }  // namespace driftlab::lockstep

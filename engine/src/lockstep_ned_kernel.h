@@ -24,6 +24,7 @@
 
 #include "lane_math.h"
 #include "lockstep_lanes.h"
+#include "nav_error_lanes.h"
 #include "random_kernels.h"
 
 namespace driftlab::lockstep {
@@ -483,6 +484,17 @@ struct Kernel {
         Store(n.v_eb_n[2], Splat(in.v_D_m_per_s[k]));
       }
     }
+  }
+
+  // The statistics' error components of the W lanes of `n` against one truth (KernelEntry::errors).
+  static void Errors(const nav_error_lanes::TruthTerms& truth, const NavLanes& n,
+                     double (*out)[kMaxLanes]) {
+    const P v[3] = {Load(n.v_eb_n[0]), Load(n.v_eb_n[1]), Load(n.v_eb_n[2])};
+    const P q[4] = {Load(n.q_b_n[0]), Load(n.q_b_n[1]), Load(n.q_b_n[2]), Load(n.q_b_n[3])};
+    P e[nav_error_lanes::kComponents];
+    nav_error_lanes::ErrorComponents<W>(truth, Load(n.lat_rad), Load(n.lon_rad), Load(n.h_m), v, q,
+                                        e);
+    for (int c = 0; c < nav_error_lanes::kComponents; ++c) Store(out[c], e[c]);
   }
 };
 

@@ -95,8 +95,8 @@ struct RunSink {
   std::vector<std::vector<ErrorComponentValues>>* checkpoint_values = nullptr;
   uint32_t slot = 0;
 
-  void Record(const Report& r, const NavError& error) const {
-    const ErrorComponentValues v = ErrorComponentsOf(error);
+  void Record(const Report& r, const NavError& error) const { Record(r, ErrorComponentsOf(error)); }
+  void Record(const Report& r, const ErrorComponentValues& v) const {
     if (r.epoch >= 0) {
       EpochSums& sums = (*epochs)[static_cast<size_t>(r.epoch)];
       for (int c = 0; c < kNumErrorComponents; ++c) {

@@ -9,6 +9,7 @@
 
 #include "driftlab/allan.h"
 #include "driftlab/spec_error.h"
+#include "nav_error_lanes.h"
 
 namespace driftlab {
 
@@ -72,6 +73,8 @@ std::string_view ErrorComponentName(ErrorComponent component) {
   return "unknown";
 }
 
+static_assert(nav_error_lanes::kComponents == kNumErrorComponents);
+
 ErrorComponentValues ErrorComponentsOf(const NavError& error) {
   ErrorComponentValues v;
   v[0] = error.r_ned_m.x();
@@ -83,8 +86,9 @@ ErrorComponentValues ErrorComponentsOf(const NavError& error) {
   v[6] = error.euler_rad.x();
   v[7] = error.euler_rad.y();
   v[8] = error.euler_rad.z();
-  v[9] = std::hypot(error.r_ned_m.x(), error.r_ned_m.y());
-  v[10] = error.r_ned_m.norm();
+  // As the lockstep kernels at one lane (nav_error_lanes.h).
+  v[9] = nav_error_lanes::Horizontal<1>(error.r_ned_m.x(), error.r_ned_m.y());
+  v[10] = nav_error_lanes::Norm3<1>(error.r_ned_m.x(), error.r_ned_m.y(), error.r_ned_m.z());
   return v;
 }
 
