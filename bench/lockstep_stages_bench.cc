@@ -4,9 +4,13 @@
 //   * sensor errors: LoadBlock + the sensor-error step (kernel advance in the alignment mode,
 //     which sums the measured increments instead of navigating);
 //   * mechanization: the NED step with coning/sculling on ideal increments (no sensor model);
+//   * statistics: at each epoch (every 100 samples, as bench/lockstep_bench.cc's job) the error
+//     components of the group's lanes against the truth (Kernel::errors, nav_error_lanes.h) and
+//     their exact sums and sums of squares (ExactSum), counted per sample covered; /1: the errors
+//     one run at a time instead (ComputeNavError + ErrorComponentsOf, as the scalar RunNed);
 // for three models: white noise only; white + Gauss-Markov + random walk on 6 axes; the tactical
 // preset. The trajectory stage is bench/engine_bench.cc's BM_Generator; end to end (shared truth,
-// runs, per-epoch statistics) is bench/lockstep_bench.cc; statistics are the difference.
+// runs, per-epoch statistics) is bench/lockstep_bench.cc.
 // The drive: 600 s at 100 Hz (60 s static, accelerate to 20 m/s, 90-degree turn, cruise).
 //   nice -n 19 build/bench/driftlab_bench_lockstep_stages --benchmark_repetitions=3
 //     --benchmark_report_aggregates_only=true   (one command line)
@@ -16,6 +20,7 @@
 #include <memory>
 #include <vector>
 
+#include "driftlab/mc_statistics.h"
 #include "driftlab/presets.h"
 #include "driftlab/trajectory.h"
 #include "car_like_motion.h"
@@ -105,7 +110,77 @@ void BM_Mechanization(benchmark::State& state) { RunStage(state, Stage::kMechani
 
 BENCHMARK(BM_Deviates)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SensorErrors)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
+// The statistics stage: the navigation state of the lanes is the mechanization's at its end on
+// ideal increments (errors of a few metres after 600 s: ordinary values for the sums), held
+// fixed; the truth is the trajectory's at each epoch.
+void BM_Statistics(benchmark::State& state) {
+  constexpr int64_t kEpochEvery = 100;
+  const Trajectory& t = Drive();
+  const std::vector<ImuIncrement>& inc = Increments();
+  const int64_t n = static_cast<int64_t>(inc.size()) - 1;
+  const lockstep::Kernel kernel = lockstep::SelectKernel();
+  const lockstep::LockstepJob job = lockstep::ComposeJob(nullptr, 1, t.environment, kRate_hz,
+                                                         NedMechanizationOptions());
+  auto group = std::make_unique<lockstep::LockstepGroup>();
+  lockstep::GroupStreams streams;
+  group->lanes = kernel.width;
+  lockstep::KernelInputs in;
+  in.increments = &inc[0].delta_theta_ib_b[0];
+  for (int lane = 0; lane < kernel.width; ++lane) {
+    lockstep::SetNavLane(t.truth[0], lane, group.get());
+  }
+  for (int64_t k = 1; k <= n; k += lockstep::kBlock) {
+    kernel.advance(job.kernel, in, k, std::min<int64_t>(k + lockstep::kBlock, n + 1), true,
+                   group.get());
+  }
+  std::vector<nav_error_lanes::TruthTerms> truth;
+  for (int64_t k = kEpochEvery; k <= n; k += kEpochEvery) {
+    const NavErrorTruth e(t.environment, t.truth[static_cast<size_t>(k)]);
+    nav_error_lanes::TruthTerms terms{};
+    terms.lat_rad = e.llh.lat_rad;
+    terms.lon_rad = e.llh.lon_rad;
+    terms.h_m = e.llh.h_m;
+    for (int i = 0; i < 3; ++i) terms.v_eb_n[i] = e.v_eb_n[i];
+    terms.north_m = e.position_scale.north_m;
+    terms.east_m = e.position_scale.east_m;
+    terms.cos_L = e.position_scale.cos_L;
+    terms.euler_rad[0] = e.euler.roll_rad;
+    terms.euler_rad[1] = e.euler.pitch_rad;
+    terms.euler_rad[2] = e.euler.yaw_rad;
+    truth.push_back(terms);
+  }
+  std::vector<EpochSums> sums(truth.size());
+  const bool per_run = state.range(0) == 1;
+  int64_t samples = 0;
+  for (auto _ : state) {
+    for (size_t epoch = 0; epoch < truth.size(); ++epoch) {
+      double errors[kNumErrorComponents][lockstep::kMaxLanes];
+      if (per_run) {
+        const NavState& truth_state = t.truth[(epoch + 1) * kEpochEvery];
+        for (int lane = 0; lane < kernel.width; ++lane) {
+          const ErrorComponentValues v = ErrorComponentsOf(ComputeNavError(
+              t.environment, lockstep::NavStateOfLane(*group, 1.0 / kRate_hz, lane), truth_state));
+          for (int c = 0; c < kNumErrorComponents; ++c) errors[c][lane] = v[c];
+        }
+      } else {
+        kernel.errors(truth[epoch], group->nav, errors);
+      }
+      for (int lane = 0; lane < kernel.width; ++lane) {
+        for (int c = 0; c < kNumErrorComponents; ++c) {
+          sums[epoch].sum[c].Add(errors[c][lane]);
+          sums[epoch].sum_squares[c].AddSquare(errors[c][lane]);
+        }
+      }
+    }
+    samples += static_cast<int64_t>(truth.size()) * kEpochEvery * kernel.width;
+  }
+  benchmark::DoNotOptimize(sums[0].sum[0]);
+  state.SetItemsProcessed(samples);
+  state.SetLabel(std::string(kernel.name) + (per_run ? " one run at a time" : ""));
+}
+
 BENCHMARK(BM_Mechanization)->Arg(0)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Statistics)->DenseRange(0, 1)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace driftlab
