@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# The engine on arm64 (issue 17: "the default build runs on any x86-64 and builds on arm64; every
+# path gives the same bits"), with Debian's cross compiler and qemu-user (scripts/ci-packages.sh
+# installs g++-aarch64-linux-gnu and qemu-user-static; without them this exits 77, skipped):
+#  1. tests/arm64/lane_bits.cc (the lane code: lane_math, the deviates, the lockstep kernel's
+#     sensor and mechanization steps, the statistics' error components) built for this machine and
+#     for arm64 with the engine's options (-ffp-contract=off; the kernel files' -fno-math-errno
+#     -fvect-cost-model=dynamic), the arm64 one run under qemu: both print the same digests, line
+#     for line; lines marked "libm" (results of the C library's atan2, asin, hypot) are reported,
+#     not required (another architecture's C library may round them differently).
+#  2. every engine source through the arm64 compiler with the engine's warnings as errors
+#     (-fsyntax-only: parsing, templates instantiated; Eigen's and oneTBB's headers are
+#     architecture-independent), and the three lockstep kernel files compiled to arm64 code.
+# Usage: same_bits.sh SOURCE_DIR WORK_DIR [HOST_CXX]
+set -euo pipefail
+src="$1"
+work="$2"
+host_cxx="${3:-c++}"
+cross=aarch64-linux-gnu-g++
+for tool in "$cross" qemu-aarch64-static; do
+  if ! command -v "$tool" > /dev/null; then
+    echo "skipped: $tool not found (Debian: g++-aarch64-linux-gnu, qemu-user-static;" \
+      "scripts/ci-packages.sh installs them)"
+    exit 77
+  fi
+done
+mkdir -p "$work/include"
+# Eigen's and oneTBB's headers as system headers for the cross compiler (their own warnings are
+# not ours), without the rest of the machine's /usr/include.
+ln -sfn /usr/include/eigen3/Eigen "$work/include/Eigen"
+ln -sfn /usr/include/eigen3/unsupported "$work/include/unsupported"
+ln -sfn /usr/include/oneapi "$work/include/oneapi"
+ln -sfn /usr/include/tbb "$work/include/tbb"
+common=(-std=c++20 -ffp-contract=off -Wall -Wextra -Wpedantic -Werror -Wno-psabi
+  "-I$src/engine/src" "-I$src/engine/include")
+kernel_options=(-O2 -fno-math-errno -fvect-cost-model=dynamic)
+
+"$host_cxx" "${common[@]}" "${kernel_options[@]}" "$src/tests/arm64/lane_bits.cc" \
+  -o "$work/lane_bits_host"
+"$cross" "${common[@]}" "${kernel_options[@]}" -static "$src/tests/arm64/lane_bits.cc" \
+  -o "$work/lane_bits_arm64"
+"$work/lane_bits_host" > "$work/host.txt"
+qemu-aarch64-static "$work/lane_bits_arm64" > "$work/arm64.txt"
+echo "--- this machine ($(uname -m))"
+cat "$work/host.txt"
+echo "--- arm64 (qemu-aarch64-static)"
+cat "$work/arm64.txt"
+if [ "$(wc -l < "$work/host.txt")" -lt 10 ]; then
+  echo "FAILED: lane_bits printed $(wc -l < "$work/host.txt") lines, expected 10" >&2
+  exit 1
+fi
+if ! diff <(grep -v '^libm ' "$work/host.txt") <(grep -v '^libm ' "$work/arm64.txt"); then
+  echo "FAILED: the lane code gives different bits on arm64 (lines above)" >&2
+  exit 1
+fi
+if diff -q <(grep '^libm ' "$work/host.txt") <(grep '^libm ' "$work/arm64.txt") > /dev/null; then
+  echo "libm lines: equal on both"
+else
+  echo "libm lines: differ (the C libraries round atan2/asin/hypot differently; not required)"
+fi
+
+echo "--- engine sources through $cross"
+failed=0
+# shellcheck disable=SC2016
+find "$src/engine/src" -name '*.cc' | sort | xargs -P "$(nproc)" -I{} sh -c '
+  "$0" "$@" -fsyntax-only -isystem "'"$work"'/include" -DDRIFTLAB_VERSION=\"0\" {} ||
+    { echo "FAILED: {}"; exit 1; }' "$cross" "${common[@]}" || failed=1
+for f in lockstep_ned_baseline lockstep_ned_avx2 lockstep_ned_avx512; do
+  "$cross" "${common[@]}" "${kernel_options[@]}" -isystem "$work/include" -c \
+    "$src/engine/src/$f.cc" -o "$work/$f.o" || failed=1
+done
+if [ "$failed" -ne 0 ]; then
+  echo "FAILED: the engine does not build for arm64 (errors above)" >&2
+  exit 1
+fi
+echo "engine: $(find "$src/engine/src" -name '*.cc' | wc -l) sources pass the arm64 compiler;" \
+  "the lockstep kernels compile to arm64 code"
+echo "PASSED: the lane code gives the same bits on $(uname -m) and arm64"
