@@ -20,10 +20,10 @@
 #include <memory>
 #include <vector>
 
+#include "car_like_motion.h"
 #include "driftlab/mc_statistics.h"
 #include "driftlab/presets.h"
 #include "driftlab/trajectory.h"
-#include "car_like_motion.h"
 #include "lockstep_ned.h"
 
 namespace driftlab {
@@ -119,8 +119,8 @@ void BM_Statistics(benchmark::State& state) {
   const std::vector<ImuIncrement>& inc = Increments();
   const int64_t n = static_cast<int64_t>(inc.size()) - 1;
   const lockstep::Kernel kernel = lockstep::SelectKernel();
-  const lockstep::LockstepJob job = lockstep::ComposeJob(nullptr, 1, t.environment, kRate_hz,
-                                                         NedMechanizationOptions());
+  const lockstep::LockstepJob job =
+      lockstep::ComposeJob(nullptr, 1, t.environment, kRate_hz, NedMechanizationOptions());
   auto group = std::make_unique<lockstep::LockstepGroup>();
   lockstep::GroupStreams streams;
   group->lanes = kernel.width;

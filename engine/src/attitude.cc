@@ -1,6 +1,5 @@
 #include "driftlab/attitude.h"
 
-#include <algorithm>
 #include <cmath>
 
 #include "lane_math.h"
@@ -38,7 +37,8 @@ Matrix3d EulerToDcm(const EulerTrig& t) {
 
 EulerAngles DcmToEuler(const Matrix3d& C_b_n) {
   double e[3];  // the lockstep kernels' code at one lane (nav_error_lanes.h)
-  nav_error_lanes::EulerOfDcm<1>(C_b_n(0, 0), C_b_n(1, 0), C_b_n(2, 0), C_b_n(2, 1), C_b_n(2, 2), e);
+  nav_error_lanes::EulerOfDcm<1>(C_b_n(0, 0), C_b_n(1, 0), C_b_n(2, 0), C_b_n(2, 1), C_b_n(2, 2),
+                                 e);
   EulerAngles out;
   out.roll_rad = e[0];
   out.pitch_rad = e[1];

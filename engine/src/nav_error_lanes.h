@@ -87,8 +87,8 @@ inline void PositionError(D<W> lat, D<W> lon, D<W> h, double truth_lat, double t
 template <int W>
 inline void EulerOfDcm(D<W> c00, D<W> c10, D<W> c20, D<W> c21, D<W> c22, D<W> (&euler)[3]) {
   euler[0] = PerLane<W>(c21, c22, [](double y, double x) { return __builtin_atan2(y, x); });
-  euler[1] = -PerLane<W>(lane_math::Clamp<W>(c20, -1.0, 1.0),
-                         [](double s) { return __builtin_asin(s); });
+  euler[1] =
+      -PerLane<W>(lane_math::Clamp<W>(c20, -1.0, 1.0), [](double s) { return __builtin_asin(s); });
   euler[2] = PerLane<W>(c10, c00, [](double y, double x) { return __builtin_atan2(y, x); });
 }
 
