@@ -4,7 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 namespace driftlab {
 namespace {
@@ -126,6 +129,32 @@ TEST(EarthTest, NedRoundTripAndSmallDisplacementsFollowTheRadii) {
   // The environment's metre scaling agrees with the exact conversion to first order.
   const NavEnvironment env = NavEnvironment::Wgs84();
   EXPECT_LT((env.PositionErrorNed(north, ref) - Vector3d(d, 0, 0)).norm(), 1e-6);
+}
+
+// The east error takes the longitude difference modulo 2 pi (nav_error_lanes.h: std::remainder,
+// skipped where it would return its argument, |d lambda| <= pi): bit for bit the remainder formula
+// over differences from -20 to 20 rad and at +-pi, and across the antimeridian the short way
+// round. Tolerances: none for the bits; the metres across the antimeridian to 1e-8 m: the two
+// longitudes are doubles near pi (rounded by up to 2.2e-16 rad each) and the period is 2 M_PI
+// (2.4e-16 below 2 pi), so the difference is 2e-7 rad to within ~7e-16 rad, 4e-9 m on this
+// 6.1e6 m radius.
+TEST(EarthTest, PositionErrorTakesTheLongitudeDifferenceModuloTwoPi) {
+  const NavEnvironment env = NavEnvironment::Wgs84();
+  const Llh truth{0.3, 0.0, 100.0};
+  const NavEnvironment::PositionScale scale = env.PositionScaleAt(truth);
+  std::vector<double> dlambda = {
+      M_PI, -M_PI, std::nextafter(M_PI, 4.0), std::nextafter(-M_PI, -4.0), 0.0, -0.0};
+  for (int i = -2000; i <= 2000; ++i) dlambda.push_back(0.01 * i + 1e-3);
+  for (const double d : dlambda) {
+    const Llh estimate{truth.lat_rad, d, truth.h_m};
+    const double expected = std::remainder(d, 2.0 * M_PI) * scale.east_m * scale.cos_L;
+    const double east = env.PositionErrorNed(estimate, truth, scale).y();
+    EXPECT_EQ(std::bit_cast<uint64_t>(east), std::bit_cast<uint64_t>(expected)) << "dlambda " << d;
+  }
+  const Llh west_of{truth.lat_rad, M_PI - 1e-7, truth.h_m};
+  const Llh east_of{truth.lat_rad, -M_PI + 1e-7, truth.h_m};
+  EXPECT_NEAR(env.PositionErrorNed(east_of, west_of).y(),
+              2e-7 * (TransverseRadius(truth.lat_rad) + truth.h_m) * std::cos(truth.lat_rad), 1e-8);
 }
 
 TEST(EarthTest, LatitudeNearMatchesLongDoubleSinCosOnBothItsPaths) {

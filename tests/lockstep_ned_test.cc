@@ -6,6 +6,7 @@
 // the same IEEE operations in the same order on the same deviates.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "driftlab/monte_carlo.h"
 #include "driftlab/presets.h"
 #include "driftlab/spec_error.h"
+#include "driftlab/trajectory.h"
 
 namespace driftlab {
 namespace {
@@ -169,6 +171,61 @@ TEST(LockstepNedTest, EveryPathMatchesScalarReferenceAfterStaticAlignment) {
   spec.sensor = FindImuPreset("industrial");
   spec.alignment.heading_sigma_rad = 0.01;
   ExpectAllPathsIdentical(spec, "external heading");
+}
+
+// The statistics' per-lane branches (nav_error_lanes.h): a car heading east at 30 m/s reaches the
+// antimeridian after 1 s, then turns to head south (yaw +-180 degrees); with initial errors of
+// 30 m east and 5 mrad in yaw, some runs' estimated longitude lies across +-pi from the truth's
+// at t = 1 s (the longitude difference goes through remainder in those lanes only) and some runs'
+// yaw error wraps at the end while others' does not. The test checks from the checkpoint values
+// that both happen for some runs and not for all.
+TEST(LockstepNedTest, EveryPathMatchesScalarReferenceAcrossTheAntimeridianAndTheYawWrap) {
+  MonteCarloSpec spec;
+  const double lat = -20.0 * kDeg, h = 10.0;
+  const double east_radius_m = (TransverseRadius(lat) + h) * std::cos(lat);
+  spec.simulation.motion.initial.llh = {lat, M_PI - 30.0 / east_radius_m, h};
+  spec.simulation.motion.initial.v_eb_n = Vector3d(0.0, 30.0, 0.0);
+  spec.simulation.motion.initial.attitude.yaw_rad = M_PI / 2.0;
+  spec.simulation.motion.segments.push_back(ConstantVelocitySegment{2.0});
+  TurnSegment turn;
+  turn.rate_rad_per_s = 0.5;
+  turn.angle_rad = M_PI / 2.0;
+  spec.simulation.motion.segments.push_back(turn);
+  spec.simulation.motion.segments.push_back(ConstantVelocitySegment{2.0});
+  spec.simulation.rate_hz = 50.0;
+  spec.runs = 13;
+  spec.seed = 7;
+  spec.sensor = FindImuPreset("tactical");
+  spec.initial_errors.position_ned_m = Vector3d(1.0, 30.0, 1.0);
+  spec.initial_errors.attitude_rad = Vector3d(1e-3, 1e-3, 5e-3);
+  spec.epoch_every_samples = 3;
+  spec.checkpoint_times_s = {1.0};
+  ExpectAllPathsIdentical(spec, "antimeridian and yaw wrap");
+
+  const MonteCarloStatisticsData d = RunMonteCarlo(spec).data();
+  const Trajectory truth = GenerateTrajectory(spec.simulation.motion, spec.simulation.rate_hz);
+  ASSERT_EQ(d.checkpoints.size(), 2u);
+  // t = 1 s: the truth within a few cm of the antimeridian (30 m/s x 0.02 s steps); a run's
+  // estimate is across when its longitude difference takes it past +-pi.
+  const NavState& at_1s = truth.truth[50];
+  ASSERT_NEAR(std::abs(at_1s.llh.lon_rad), M_PI, 1.0 / east_radius_m);
+  int across = 0;
+  for (const ErrorComponentValues& v : d.checkpoints[0].values) {
+    const double lon = at_1s.llh.lon_rad + v[1] / east_radius_m;
+    across += (lon > M_PI || lon <= -M_PI) ? 1 : 0;
+  }
+  EXPECT_GT(across, 0) << "runs across the antimeridian from the truth at t = 1 s";
+  EXPECT_LT(across, spec.runs) << "runs across the antimeridian from the truth at t = 1 s";
+  // The end: the truth heads south; a run's yaw error wraps when its estimated yaw is across +-pi.
+  const double truth_yaw = truth.truth.back().euler().yaw_rad;
+  ASSERT_NEAR(std::abs(truth_yaw), M_PI, 1e-6);
+  int wrapped = 0;
+  for (const ErrorComponentValues& v : d.checkpoints[1].values) {
+    const double yaw = truth_yaw + v[8];
+    wrapped += (yaw > M_PI || yaw <= -M_PI) ? 1 : 0;
+  }
+  EXPECT_GT(wrapped, 0) << "runs whose yaw error wraps at the end";
+  EXPECT_LT(wrapped, spec.runs) << "runs whose yaw error wraps at the end";
 }
 
 TEST(LockstepNedTest, ThreadsAndShardsGiveTheSameBitsOnEveryPath) {
