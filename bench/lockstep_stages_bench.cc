@@ -135,19 +135,7 @@ void BM_Statistics(benchmark::State& state) {
   }
   std::vector<nav_error_lanes::TruthTerms> truth;
   for (int64_t k = kEpochEvery; k <= n; k += kEpochEvery) {
-    const NavErrorTruth e(t.environment, t.truth[static_cast<size_t>(k)]);
-    nav_error_lanes::TruthTerms terms{};
-    terms.lat_rad = e.llh.lat_rad;
-    terms.lon_rad = e.llh.lon_rad;
-    terms.h_m = e.llh.h_m;
-    for (int i = 0; i < 3; ++i) terms.v_eb_n[i] = e.v_eb_n[i];
-    terms.north_m = e.position_scale.north_m;
-    terms.east_m = e.position_scale.east_m;
-    terms.cos_L = e.position_scale.cos_L;
-    terms.euler_rad[0] = e.euler.roll_rad;
-    terms.euler_rad[1] = e.euler.pitch_rad;
-    terms.euler_rad[2] = e.euler.yaw_rad;
-    truth.push_back(terms);
+    truth.push_back(lockstep::ErrorTruthTerms(t.environment, t.truth[static_cast<size_t>(k)]));
   }
   std::vector<EpochSums> sums(truth.size());
   const bool per_run = state.range(0) == 1;

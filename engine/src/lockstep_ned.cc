@@ -227,6 +227,22 @@ NavState NavStateOfLane(const LockstepGroup& group, double dt_s, int lane) {
   return s;
 }
 
+nav_error_lanes::TruthTerms ErrorTruthTerms(const NavEnvironment& env, const NavState& truth) {
+  const NavErrorTruth t(env, truth);
+  nav_error_lanes::TruthTerms terms{};
+  terms.lat_rad = t.llh.lat_rad;
+  terms.lon_rad = t.llh.lon_rad;
+  terms.h_m = t.llh.h_m;
+  for (int i = 0; i < 3; ++i) terms.v_eb_n[i] = t.v_eb_n[i];
+  terms.north_m = t.position_scale.north_m;
+  terms.east_m = t.position_scale.east_m;
+  terms.cos_L = t.position_scale.cos_L;
+  terms.euler_rad[0] = t.euler.roll_rad;
+  terms.euler_rad[1] = t.euler.pitch_rad;
+  terms.euler_rad[2] = t.euler.yaw_rad;
+  return terms;
+}
+
 bool IsaAvailable(Isa isa) {
   switch (isa) {
     case Isa::kBaseline:

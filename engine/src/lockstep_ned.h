@@ -114,5 +114,8 @@ void LoadBlock(const LockstepJob& job, const Kernel& kernel, int64_t block_begin
                GroupStreams* streams, LockstepGroup* group);
 // Lane `lane`'s navigation state (NedMechanization::state()).
 NavState NavStateOfLane(const LockstepGroup& group, double dt_s, int lane);
+// The truth's share of the error components at one epoch (NavErrorTruth: position scaling, Euler
+// angles), for Kernel::errors.
+nav_error_lanes::TruthTerms ErrorTruthTerms(const NavEnvironment& env, const NavState& truth);
 
 }  // namespace driftlab::lockstep

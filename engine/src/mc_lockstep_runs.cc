@@ -43,18 +43,8 @@ bool RunNedGroup(const SharedTruth& s, const MonteCarloSpec& spec, const lockste
   // The errors of all lanes at once (the kernel's nav_error_lanes::ErrorComponents: the
   // operations of ErrorComponentsOf(ComputeNavError(...)) in RunNed), then each run's sums.
   auto record = [&](const Report& r) {
-    const NavErrorTruth truth(s.env, r.truth);  // once for the group's lanes
-    nav_error_lanes::TruthTerms terms{};
-    terms.lat_rad = truth.llh.lat_rad;
-    terms.lon_rad = truth.llh.lon_rad;
-    terms.h_m = truth.llh.h_m;
-    terms.north_m = truth.position_scale.north_m;
-    terms.east_m = truth.position_scale.east_m;
-    terms.cos_L = truth.position_scale.cos_L;
-    for (int i = 0; i < 3; ++i) terms.v_eb_n[i] = truth.v_eb_n[i];
-    terms.euler_rad[0] = truth.euler.roll_rad;
-    terms.euler_rad[1] = truth.euler.pitch_rad;
-    terms.euler_rad[2] = truth.euler.yaw_rad;
+    // The truth's share once for the group's lanes.
+    const nav_error_lanes::TruthTerms terms = lockstep::ErrorTruthTerms(s.env, r.truth);
     double errors[kNumErrorComponents][lockstep::kMaxLanes];
     kernel.errors(terms, group->nav, errors);
     for (int lane = 0; lane < lanes; ++lane) {
