@@ -11,6 +11,7 @@
 
 #include "driftlab/attitude.h"
 #include "driftlab/earth.h"
+#include "driftlab/elementary.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::calib {
@@ -300,7 +301,7 @@ GyroCalibration CalibrateGyros(const RawImuRecording& recording,
     Eigen::Vector3d angle = Eigen::Vector3d::Zero();
     for (int64_t i = poses[k].end; i < poses[k + 1].begin; ++i)
       angle += (rates[i] - out.b_g) * dt[i];
-    const double moved = std::max(angle.norm(), std::acos(std::clamp(d_k.dot(d_next), -1.0, 1.0)));
+    const double moved = std::max(angle.norm(), math::Acos(std::clamp(d_k.dot(d_next), -1.0, 1.0)));
     if (moved < options.min_rotation_rad) {
       out.fit.messages.push_back(
           fmt::format("poses {} and {} skipped: no motion between them ({:.3g} deg < {:.3g} deg)",

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "driftlab/allan.h"
+#include "driftlab/elementary.h"
 #include "driftlab/sensors.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/units.h"
@@ -37,7 +38,7 @@ double Digamma(double x) {
     x += 1.0;
   }
   const double x2 = 1.0 / (x * x);
-  return r + std::log(x) - 0.5 / x -
+  return r + math::Log(x) - 0.5 / x -
          x2 * (1.0 / 12.0 - x2 * (1.0 / 120.0 - x2 * (1.0 / 252.0 - x2 / 240.0)));
 }
 
@@ -82,18 +83,18 @@ class PointCost final : public ceres::CostFunction {
     std::array<double, kTerms> f = point_.basis;
     double d_gm = 0.0;  // d f_B / d ln tau
     if (gauss_markov_) {
-      const double tau = std::exp(parameters[1][0]);
+      const double tau = math::Exp(parameters[1][0]);
       f[kB] = GaussMarkovShape(tau, point_.tau_s);
       // Central difference in ln tau, step 1e-4: truncation error ~ h^2 / 6 f''' ~ 2e-9 relative.
       constexpr double kH = 1e-4;
-      d_gm = (GaussMarkovShape(tau * std::exp(kH), point_.tau_s) -
-              GaussMarkovShape(tau * std::exp(-kH), point_.tau_s)) /
+      d_gm = (GaussMarkovShape(tau * math::Exp(kH), point_.tau_s) -
+              GaussMarkovShape(tau * math::Exp(-kH), point_.tau_s)) /
              (2.0 * kH);
     }
     double model = 0.0;
     for (int k = 0; k < kTerms; ++k) model += scale_[k] * x[k] * f[k];
     if (!(model > 0.0) || !std::isfinite(model)) return false;
-    residuals[0] = (std::log(model) - point_.y) / point_.sigma;
+    residuals[0] = (math::Log(model) - point_.y) / point_.sigma;
     if (jacobians != nullptr) {
       const double g = 1.0 / (model * point_.sigma);
       if (jacobians[0] != nullptr) {
@@ -311,8 +312,8 @@ Pass Solve(const Problem& pr, const std::array<bool, kTerms>& active,
   if (pr.gauss_markov) {
     if (fit_tau) {
       // tau between a tenth of the shortest and ten times the longest averaging time.
-      problem.SetParameterLowerBound(&pass.ln_tau_gm, 0, std::log(pr.tau_first / 10.0));
-      problem.SetParameterUpperBound(&pass.ln_tau_gm, 0, std::log(pr.tau_last * 10.0));
+      problem.SetParameterLowerBound(&pass.ln_tau_gm, 0, math::Log(pr.tau_first / 10.0));
+      problem.SetParameterUpperBound(&pass.ln_tau_gm, 0, math::Log(pr.tau_last * 10.0));
     } else {
       problem.SetParameterBlockConstant(&pass.ln_tau_gm);
     }
@@ -350,7 +351,7 @@ Pass Solve(const Problem& pr, const std::array<bool, kTerms>& active,
 
 // Smallest k with P(Binomial(n, p) <= k) >= q.
 int BinomialQuantile(int n, double p, double q) {
-  double term = std::pow(1.0 - p, n);  // P(X = 0)
+  double term = math::Exp(n * math::Log1p(-p));  // P(X = 0) = (1 - p)^n
   double cdf = term;
   int k = 0;
   while (cdf < q && k < n) {
@@ -429,7 +430,7 @@ NoiseFitResult FitAllanNoiseModel(std::span<const std::vector<AllanPoint>> curve
       FitPoint fp;
       fp.tau_s = p.tau_s;
       const double half_edf = 0.5 * p.edf;
-      fp.y = 2.0 * std::log(p.adev) - (Digamma(half_edf) - std::log(half_edf));
+      fp.y = 2.0 * math::Log(p.adev) - (Digamma(half_edf) - math::Log(half_edf));
       fp.sigma = std::sqrt(Trigamma(half_edf));
       fp.basis =
           Basis(options.bias_model, result.flicker_tau_min_s, result.flicker_tau_max_s, p.tau_s);
@@ -447,14 +448,14 @@ NoiseFitResult FitAllanNoiseModel(std::span<const std::vector<AllanPoint>> curve
 
   // Scale of each coefficient: the largest variance the term alone may have without exceeding
   // the data at any point, s_k = min_i AVAR_i / f_k(t_i); x_k = a_k / s_k is then O(1) or less.
-  double ln_tau_gm = std::log(std::sqrt(tau_first * tau_last));
+  double ln_tau_gm = math::Log(std::sqrt(tau_first * tau_last));
   std::array<double, kTerms> scale{};
   for (int k = 0; k < kTerms; ++k) {
     scale[k] = INFINITY;
     for (const FitPoint& p : points) {
       const double f =
-          (k == kB && gauss_markov) ? GaussMarkovShape(std::exp(ln_tau_gm), p.tau_s) : p.basis[k];
-      if (f > 0.0) scale[k] = std::min(scale[k], std::exp(p.y) / f);
+          (k == kB && gauss_markov) ? GaussMarkovShape(math::Exp(ln_tau_gm), p.tau_s) : p.basis[k];
+      if (f > 0.0) scale[k] = std::min(scale[k], math::Exp(p.y) / f);
     }
     if (!std::isfinite(scale[k]) || !(scale[k] > 0.0)) {
       active[k] = false;
@@ -576,10 +577,10 @@ NoiseFitResult FitAllanNoiseModel(std::span<const std::vector<AllanPoint>> curve
     if (active[kB]) {
       const double sigma_ln_tau = std::sqrt(std::max(0.0, current.var_ln_tau) * infl);
       t.determined = true;
-      t.value = std::exp(current.ln_tau_gm);
+      t.value = math::Exp(current.ln_tau_gm);
       t.sigma = t.value * sigma_ln_tau;  // d tau = tau d ln tau
-      t.lower_95 = t.value * std::exp(-1.96 * sigma_ln_tau);
-      t.upper_95 = t.value * std::exp(1.96 * sigma_ln_tau);
+      t.lower_95 = t.value * math::Exp(-1.96 * sigma_ln_tau);
+      t.upper_95 = t.value * math::Exp(1.96 * sigma_ln_tau);
     } else {
       t.determined = false;
       t.value = 0.0;

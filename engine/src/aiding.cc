@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "driftlab/elementary.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab {
@@ -100,7 +101,7 @@ void ValidateAidingSpec(const AidingSpec& a, double imu_rate_hz, double duration
 }
 
 double MagneticDeclination(const Vector3d& earth_field_n) {
-  return std::atan2(earth_field_n.y(), earth_field_n.x());
+  return math::Atan2(earth_field_n.y(), earth_field_n.x());
 }
 
 BarometerSimulator::BarometerSimulator(const BarometerConfig& config, double imu_rate_hz,
@@ -113,7 +114,7 @@ BarometerSimulator::BarometerSimulator(const BarometerConfig& config, double imu
   if (config.bias.sigma > 0.0) {
     // b_{j+1} = a b_j + sigma sqrt(1 - a^2) w_j, a = exp(-T / tau): exact for the continuous
     // first-order Gauss-Markov process sampled at T (Maybeck vol. 1, section 4.9).
-    gm_a_ = std::exp(-1.0 / (config.rate_hz * config.bias.tau_s));
+    gm_a_ = math::Exp(-1.0 / (config.rate_hz * config.bias.tau_s));
     gm_drive_ = config.bias.sigma * std::sqrt(1.0 - gm_a_ * gm_a_);
     const RandomStream start(seed, run_index,
                              {SensorId::kBarometer, 0, ErrorTerm::kInitialState, 0});

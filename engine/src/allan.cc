@@ -9,6 +9,7 @@
 #include <span>
 #include <string>
 
+#include "driftlab/elementary.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab {
@@ -150,8 +151,8 @@ double OverlappingAdevEdf(AllanNoiseType noise_type, int64_t n_phase, int64_t m)
       edf = (N + 1.0) * (N - 2.0 * M) / (2.0 * (N - M));
       break;
     case AllanNoiseType::kFlickerPm:  // exp(sqrt(ln((N - 1) / 2m) ln((2m + 1)(N - 1) / 4)))
-      edf = std::exp(std::sqrt(std::max(
-          0.0, std::log((N - 1.0) / (2.0 * M)) * std::log((2.0 * M + 1.0) * (N - 1.0) / 4.0))));
+      edf = math::Exp(std::sqrt(std::max(
+          0.0, math::Log((N - 1.0) / (2.0 * M)) * math::Log((2.0 * M + 1.0) * (N - 1.0) / 4.0))));
       break;
     case AllanNoiseType::kWhiteFm:  // (3 (N - 1) / 2m - 2 (N - 2) / N) 4 m^2 / (4 m^2 + 5)
       edf = (3.0 * (N - 1.0) / (2.0 * M) - 2.0 * (N - 2.0) / N) * 4.0 * M * M / (4.0 * M * M + 5.0);
@@ -276,7 +277,7 @@ std::vector<AllanPoint> OverlappingAllanDeviation(std::span<const double> rate_s
 double AllanCurveModel(double tau_s, double N, double B, double K, double Q, double R) {
   // IEEE Std 952-1997 table C.2; 2 ln 2 / pi = 0.4413 is the flat flicker level (0.664 B)^2.
   const double avar = 3.0 * Q * Q / (tau_s * tau_s) + N * N / tau_s +
-                      2.0 * std::log(2.0) / M_PI * B * B + K * K * tau_s / 3.0 +
+                      2.0 * math::Log(2.0) / M_PI * B * B + K * K * tau_s / 3.0 +
                       R * R * tau_s * tau_s / 2.0;
   return std::sqrt(avar);
 }
@@ -303,13 +304,13 @@ AllanTermFit FitSlope(std::span<const AllanPoint> curve, const std::vector<doubl
     if (!(std::abs(local_slope[i] - slope) <= tolerance) || !(curve[i].adev > 0.0)) continue;
     const double w = curve[i].edf;
     sum_w += w;
-    sum_wy += w * (std::log(curve[i].adev) - slope * std::log(curve[i].tau_s));
+    sum_wy += w * (math::Log(curve[i].adev) - slope * math::Log(curve[i].tau_s));
     if (fit.n_points == 0) fit.tau_min_s = curve[i].tau_s;
     fit.tau_max_s = curve[i].tau_s;
     ++fit.n_points;
   }
   if (fit.n_points > 0 && sum_w > 0.0) {
-    fit.value = std::exp(sum_wy / sum_w + slope * std::log(tau_ref_s));
+    fit.value = math::Exp(sum_wy / sum_w + slope * math::Log(tau_ref_s));
   } else {
     fit = AllanTermFit();
   }
@@ -329,10 +330,10 @@ AllanReadOff ReadOffNoiseTerms(std::span<const AllanPoint> curve) {
   for (size_t i = 0; i < curve.size(); ++i) {
     const size_t a = i == 0 ? 0 : i - 1;
     const size_t b = i + 1 == curve.size() ? i : i + 1;
-    const double d_ln_tau = std::log(curve[b].tau_s) - std::log(curve[a].tau_s);
+    const double d_ln_tau = math::Log(curve[b].tau_s) - math::Log(curve[a].tau_s);
     const bool valid = curve[a].adev > 0.0 && curve[b].adev > 0.0 && d_ln_tau > 0.0 &&
                        curve[a].edf > 0.0 && curve[b].edf > 0.0;
-    slope[i] = valid ? (std::log(curve[b].adev) - std::log(curve[a].adev)) / d_ln_tau
+    slope[i] = valid ? (math::Log(curve[b].adev) - math::Log(curve[a].adev)) / d_ln_tau
                      : std::numeric_limits<double>::quiet_NaN();
     slope_sigma[i] =
         valid ? std::sqrt(0.5 / curve[a].edf + 0.5 / curve[b].edf) / d_ln_tau : kMaxSlopeTolerance;
@@ -350,7 +351,7 @@ AllanReadOff ReadOffNoiseTerms(std::span<const AllanPoint> curve) {
     if (curve[i].adev < curve[i_min].adev) i_min = i;
   }
   if (i_min > 0 && i_min + 1 < curve.size()) {
-    out.bias_instability.value = curve[i_min].adev / std::sqrt(2.0 * std::log(2.0) / M_PI);
+    out.bias_instability.value = curve[i_min].adev / std::sqrt(2.0 * math::Log(2.0) / M_PI);
     out.bias_instability.tau_min_s = curve[i_min].tau_s;
     out.bias_instability.tau_max_s = curve[i_min].tau_s;
     out.bias_instability.n_points = 1;

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "driftlab/elementary.h"
 #include "lane_math.h"
 #include "nav_error_lanes.h"
 
@@ -15,13 +16,11 @@ Matrix3d Skew(const Vector3d& a) {
   return S;
 }
 
-EulerTrig::EulerTrig(const EulerAngles& e)
-    : sp(std::sin(e.roll_rad)),
-      cp(std::cos(e.roll_rad)),
-      st(std::sin(e.pitch_rad)),
-      ct(std::cos(e.pitch_rad)),
-      ss(std::sin(e.yaw_rad)),
-      cs(std::cos(e.yaw_rad)) {}
+EulerTrig::EulerTrig(const EulerAngles& e) {
+  math::SinCos(e.roll_rad, &sp, &cp);
+  math::SinCos(e.pitch_rad, &st, &ct);
+  math::SinCos(e.yaw_rad, &ss, &cs);
+}
 
 Matrix3d EulerToDcm(const EulerAngles& e) { return EulerToDcm(EulerTrig(e)); }
 
@@ -86,7 +85,7 @@ Vector3d QuaternionToRotationVector(const Quaterniond& q_in) {
   const Vector3d v = q.vec();
   const double s = v.norm();
   if (s < 1e-8) return 2.0 * v / q.w();  // 2 atan(s/w) / s -> 2/w, error O(s^2)
-  const double angle = 2.0 * std::atan2(s, q.w());
+  const double angle = 2.0 * math::Atan2(s, q.w());
   return v * (angle / s);
 }
 

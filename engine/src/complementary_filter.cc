@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <string>
 
+#include "driftlab/elementary.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab {
@@ -48,9 +49,9 @@ Biquad FirstOrderLowPass(double c) {
 
 // Euler-angle rates from the body rate (Groves (2.58)).
 Vector3d EulerRates(double roll, double pitch, const Vector3d& w) {
-  const double s = std::sin(roll), c = std::cos(roll);
+  const double s = math::Sin(roll), c = math::Cos(roll);
   const double yz = w.y() * s + w.z() * c;
-  return Vector3d(w.x() + yz * std::tan(pitch), w.y() * c - w.z() * s, yz / std::cos(pitch));
+  return Vector3d(w.x() + yz * math::Tan(pitch), w.y() * c - w.z() * s, yz / math::Cos(pitch));
 }
 
 }  // namespace
@@ -118,14 +119,14 @@ ComplementaryPairDesign DesignComplementaryPair(ComplementaryPairKind kind, doub
   d.kind = kind;
   d.crossover_hz = crossover_hz;
   d.rate_hz = rate_hz;
-  const double c = 1.0 / std::tan(M_PI * crossover_hz / rate_hz);  // 1 / tan(w_c dt / 2)
+  const double c = 1.0 / math::Tan(M_PI * crossover_hz / rate_hz);  // 1 / tan(w_c dt / 2)
   if (kind == ComplementaryPairKind::kFirstOrder) {
     d.low_pass = IirCascade({FirstOrderLowPass(c), Biquad{}}, 1);
     return d;
   }
   // Butterworth n = 4: B(p) = (p^2 + 2 sin(pi/8) p + 1)(p^2 + 2 sin(3 pi/8) p + 1)
   // = p^4 + 2.6131 p^3 + 3.4142 p^2 + 2.6131 p + 1 (poles exp(j pi (2k + 3) / 8), k = 0..3).
-  const double b1 = 2.0 * std::sin(M_PI / 8.0), b2 = 2.0 * std::sin(3.0 * M_PI / 8.0);
+  const double b1 = 2.0 * math::Sin(M_PI / 8.0), b2 = 2.0 * math::Sin(3.0 * M_PI / 8.0);
   d.low_pass = IirCascade({SecondOrderSection(b1, c, false), SecondOrderSection(b2, c, false)}, 2);
   if (kind == ComplementaryPairKind::kButterworth4Seed) {
     d.high_pass = IirCascade({SecondOrderSection(b1, c, true), SecondOrderSection(b2, c, true)}, 2);
@@ -135,18 +136,18 @@ ComplementaryPairDesign DesignComplementaryPair(ComplementaryPairKind kind, doub
 
 EulerAngles AccelerometerTilt(const Vector3d& f_ib_b) {
   EulerAngles e;
-  e.roll_rad = std::atan2(-f_ib_b.y(), -f_ib_b.z());
-  e.pitch_rad = std::atan(f_ib_b.x() / std::hypot(f_ib_b.y(), f_ib_b.z()));
+  e.roll_rad = math::Atan2(-f_ib_b.y(), -f_ib_b.z());
+  e.pitch_rad = math::Atan(f_ib_b.x() / math::Hypot(f_ib_b.y(), f_ib_b.z()));
   return e;
 }
 
 double MagneticHeading(const Vector3d& m_b, double roll_rad, double pitch_rad,
                        double declination_rad) {
-  const double sr = std::sin(roll_rad), cr = std::cos(roll_rad);
-  const double sp = std::sin(pitch_rad), cp = std::cos(pitch_rad);
+  const double sr = math::Sin(roll_rad), cr = math::Cos(roll_rad);
+  const double sp = math::Sin(pitch_rad), cp = math::Cos(pitch_rad);
   const double mx = m_b.x() * cp + (m_b.y() * sr + m_b.z() * cr) * sp;
   const double my = m_b.y() * cr - m_b.z() * sr;
-  return WrapPi(std::atan2(-my, mx) + declination_rad);
+  return WrapPi(math::Atan2(-my, mx) + declination_rad);
 }
 
 ComplementaryAttitudeFilter::ComplementaryAttitudeFilter(const ComplementaryFilterOptions& options,

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "driftlab/elementary.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab {
@@ -51,10 +52,9 @@ void ErrorCovariancePropagator::Propagate(const NavState& reference, const Vecto
   const Eigen::Matrix<double, n, 1> q_n = Q_c_.diagonal().head(n);
   // Q_d = dt / 2 (Phi Q_c Phi^T + Q_c), Q_c = diag(q_n, q_s).
   const Eigen::MatrixXd BQ = B_ * q_s_.asDiagonal();  // n x m
-  const Eigen::MatrixXd Qd_nn =
-      0.5 * dt_s *
-      (A_ * q_n.asDiagonal() * A_.transpose() + BQ * B_.transpose() +
-       Eigen::Matrix<double, n, n>(q_n.asDiagonal()));
+  const Eigen::MatrixXd Qd_nn = 0.5 * dt_s *
+                                (A_ * q_n.asDiagonal() * A_.transpose() + BQ * B_.transpose() +
+                                 Eigen::Matrix<double, n, n>(q_n.asDiagonal()));
   const Eigen::MatrixXd Qd_ns = 0.5 * dt_s * BQ * d_.asDiagonal();
   const Eigen::VectorXd Qd_ss = 0.5 * dt_s * (d_.cwiseAbs2().cwiseProduct(q_s_) + q_s_);
   ApplyStructuredStep(Qd_nn, Qd_ns, Qd_ss);
@@ -63,7 +63,8 @@ void ErrorCovariancePropagator::Propagate(const NavState& reference, const Vecto
 void ErrorCovariancePropagator::ApplyStructuredStep(const Eigen::MatrixXd& Qd_nn,
                                                     const Eigen::MatrixXd& Qd_ns,
                                                     const Eigen::VectorXd& Qd_ss) {
-  // P <- Phi P Phi^T + Q_d with Phi = [[A, B], [0, diag(d)]] and P = [[P_nn, P_ns], [P_ns^T, P_ss]].
+  // P <- Phi P Phi^T + Q_d with Phi = [[A, B], [0, diag(d)]] and P = [[P_nn, P_ns], [P_ns^T,
+  // P_ss]].
   constexpr int n = kNumNavErrorStates;
   const int m = layout_.size - n;
   const auto P_nn = P_.topLeftCorner(n, n);
@@ -121,13 +122,13 @@ bool ErrorCovariancePropagator::PropagateExactSeries(const ErrorStateMatrix& F, 
     E.push_back(E[k - 1].cwiseProduct(Dh) / k);
     A_ += N[k];
     B_ += U[k];
-    const double added = N[k].cwiseAbs().maxCoeff() + U[k].cwiseAbs().maxCoeff() +
-                         E[k].cwiseAbs().maxCoeff();
+    const double added =
+        N[k].cwiseAbs().maxCoeff() + U[k].cwiseAbs().maxCoeff() + E[k].cwiseAbs().maxCoeff();
     const double total = A_.cwiseAbs().maxCoeff() + B_.cwiseAbs().maxCoeff() + 1.0;
     if (added < 1e-17 * total) break;
   }
   const int K = static_cast<int>(N.size());
-  d_ = Dh.array().exp().matrix();
+  d_ = Dh.unaryExpr([](double v) { return math::Exp(v); });  // the engine's exp (elementary.h)
   const Eigen::Matrix<double, n, 1> q_n = Q_c_.diagonal().head(n);
   // Q_d blocks: nn = h sum_(i,j) (N_i Q_n N_j^T + U_i Q_s U_j^T) / (i + j + 1);
   // ns = h sum_i U_i diag(q_s G_i), G_i = sum_j E_j / (i + j + 1) = int_0^1 s^i exp(D h s) ds.
@@ -155,7 +156,7 @@ bool ErrorCovariancePropagator::PropagateExactSeries(const ErrorStateMatrix& F, 
   for (int j = 0; j < m; ++j) {
     // int_0^h exp(2 d s) ds = h expm1(2 d h) / (2 d h), -> h as d h -> 0.
     const double x = 2.0 * Dh(j);
-    Qd_ss(j) = q_s_(j) * h * (x == 0.0 ? 1.0 : std::expm1(x) / x);
+    Qd_ss(j) = q_s_(j) * h * (x == 0.0 ? 1.0 : math::Expm1(x) / x);
   }
   ApplyStructuredStep(Qd_nn, Qd_ns, Qd_ss);
   return true;

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "driftlab/elementary.h"
 #include "lane_math.h"
 #include "nav_error_lanes.h"
 
@@ -108,10 +109,10 @@ Vector3d LlhToEcef(const Llh& llh) {
 
 Llh EcefToLlh(const Vector3d& r_eb_e) {
   const double a = kWgs84SemiMajorAxis_m, b = kWgs84SemiMinorAxis_m, e2 = kWgs84Eccentricity2;
-  const double p = std::hypot(r_eb_e.x(), r_eb_e.y());
+  const double p = math::Hypot(r_eb_e.x(), r_eb_e.y());
   const double z = r_eb_e.z();
   Llh llh;
-  llh.lon_rad = std::atan2(r_eb_e.y(), r_eb_e.x());
+  llh.lon_rad = math::Atan2(r_eb_e.y(), r_eb_e.x());
   if (p < 1e-9) {  // on the polar axis
     llh.lat_rad = z >= 0.0 ? M_PI / 2.0 : -M_PI / 2.0;
     llh.h_m = std::abs(z) - b;
@@ -120,23 +121,25 @@ Llh EcefToLlh(const Vector3d& r_eb_e) {
   // Bowring's initial guess (ep2 = second eccentricity squared), then fixed-point iteration
   // of L = atan((z + e^2 R_E sin L) / p), which converges quadratically from this start.
   const double ep2 = e2 / (1.0 - e2);
-  const double u = std::atan2(z * a, p * b);
-  double L = std::atan2(z + ep2 * b * std::pow(Sin(u), 3), p - e2 * a * std::pow(Cos(u), 3));
+  const double u = math::Atan2(z * a, p * b);
+  const double su = Sin(u), cu = Cos(u);
+  double L = math::Atan2(z + ep2 * b * (su * su * su), p - e2 * a * (cu * cu * cu));
   for (int i = 0; i < 8; ++i) {
     const double R_E = TransverseRadius(L);
-    const double L_next = std::atan2(z + e2 * R_E * Sin(L), p);
+    const double L_next = math::Atan2(z + e2 * R_E * Sin(L), p);
     const bool done = std::abs(L_next - L) < 1e-15;
     L = L_next;
     if (done) break;
   }
   llh.lat_rad = L;
   const double R_E = TransverseRadius(L);
-  // Height: use the better-conditioned form away from the poles.
-  if (std::abs(Cos(L)) > 1e-3) {
-    llh.h_m = p / Cos(L) - R_E;
-  } else {
-    llh.h_m = z / Sin(L) - (1.0 - e2) * R_E;
-  }
+  // Height along the ellipsoid normal: h = p cos L + z sin L - a^2 / R_E (the distance of r_eb_e
+  // from the ellipsoid measured on the normal at L; first-order insensitive to an error in L,
+  // unlike p / cos L - R_E, whose error grows as R tan L dL towards the poles). Bowring, "The
+  // accuracy of geodetic latitude and height equations", Survey Review 28 (1985) 202-206.
+  double sL, cL;
+  math::SinCos(L, &sL, &cL);
+  llh.h_m = (p * cL + z * sL) - a * a / R_E;
   return llh;
 }
 

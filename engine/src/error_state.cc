@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "driftlab/attitude.h"
+#include "driftlab/elementary.h"
 #include "driftlab/sensors.h"
 
 namespace driftlab {
@@ -144,18 +145,18 @@ std::vector<BiasStateModel> FitFlickerStates(const FlickerParams& flicker, int c
     return out;
   }
   count = std::max(count, 1);
-  const double lo = std::log(std::max(t_min_s, 1e-6));
-  const double hi = std::log(std::max(t_max_s, std::max(t_min_s, 1e-6) * 1.0001));
+  const double lo = math::Log(std::max(t_min_s, 1e-6));
+  const double hi = math::Log(std::max(t_max_s, std::max(t_min_s, 1e-6) * 1.0001));
   std::vector<double> variance(static_cast<size_t>(count), 0.0);
   std::vector<double> log_tau_sum(static_cast<size_t>(count), 0.0);
   for (const GaussMarkovComponent& c : design) {
-    const double x = (std::log(c.tau_s) - lo) / (hi - lo) * count;
+    const double x = (math::Log(c.tau_s) - lo) / (hi - lo) * count;
     const int g = std::clamp(static_cast<int>(std::floor(x)), 0, count - 1);
     variance[g] += c.sigma * c.sigma;
-    log_tau_sum[g] += c.sigma * c.sigma * std::log(c.tau_s);
+    log_tau_sum[g] += c.sigma * c.sigma * math::Log(c.tau_s);
   }
   for (int g = 0; g < count; ++g) {
-    if (variance[g] > 0.0) out.push_back(gm(variance[g], std::exp(log_tau_sum[g] / variance[g])));
+    if (variance[g] > 0.0) out.push_back(gm(variance[g], math::Exp(log_tau_sum[g] / variance[g])));
   }
   return out;
 }
@@ -206,7 +207,7 @@ ErrorStateMatrix ErrorStateSystemMatrix(const NavEnvironment& env, const NavStat
   const Vector3d& v = reference.v_eb_n;
   const double RN = env.MeridianRadiusAt(L) + h;
   const double RE = env.TransverseRadiusAt(L) + h;
-  const double tanL = std::tan(L);
+  const double tanL = math::Tan(L);
   const Matrix3d C_b_n = reference.C_b_n();
   const Vector3d omega_ie_n = env.EarthRate(L);
   const Vector3d omega_en_n = env.TransportRate(L, h, v);
@@ -224,7 +225,7 @@ ErrorStateMatrix ErrorStateSystemMatrix(const NavEnvironment& env, const NavStat
     Wen_v(1, 0) = -1.0 / RN;
     Wen_v(0, 1) = 1.0 / RE;
     Wen_v(2, 1) = -tanL / RE;
-    const double cosL = std::cos(L);
+    const double cosL = math::Cos(L);
     Wen_r(2, 0) = -v.y() / (RE * cosL * cosL) / RN;  // dL = dr_N / RN
     // dh = -dr_D
     Wen_r(0, 2) = v.y() / (RE * RE);
@@ -342,8 +343,8 @@ void DiscretizeErrorModel(const ErrorStateMatrix& F, const ErrorStateMatrix& Q_c
 }
 
 Matrix3d EulerErrorFromAttitudeError(const EulerAngles& e) {
-  const double cy = std::cos(e.yaw_rad), sy = std::sin(e.yaw_rad);
-  const double cp = std::cos(e.pitch_rad), sp = std::sin(e.pitch_rad);
+  const double cy = math::Cos(e.yaw_rad), sy = math::Sin(e.yaw_rad);
+  const double cp = math::Cos(e.pitch_rad), sp = math::Sin(e.pitch_rad);
   Matrix3d E;
   E.col(0) = Vector3d(cp * cy, cp * sy, -sp);  // roll axis: Rz Ry x
   E.col(1) = Vector3d(-sy, cy, 0.0);           // pitch axis: Rz y

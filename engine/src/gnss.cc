@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "driftlab/attitude.h"
+#include "driftlab/elementary.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab {
@@ -83,7 +84,7 @@ void AntennaState(const NavEnvironment& env, const NavState& body, const Vector3
   const Vector3d l_n = C * lever_arm_b_m;
   const double L = body.llh.lat_rad, h = body.llh.h_m;
   llh->lat_rad = L + l_n.x() / (env.MeridianRadiusAt(L) + h);
-  llh->lon_rad = body.llh.lon_rad + l_n.y() / ((env.TransverseRadiusAt(L) + h) * std::cos(L));
+  llh->lon_rad = body.llh.lon_rad + l_n.y() / ((env.TransverseRadiusAt(L) + h) * math::Cos(L));
   llh->h_m = h - l_n.z();
   *v_eb_n = body.v_eb_n + C * omega_ib_b.cross(lever_arm_b_m) - env.EarthRate(L).cross(l_n);
 }
@@ -96,7 +97,7 @@ GnssSimulator::GnssSimulator(const GnssConfig& config, const NavEnvironment& env
   decimation_ = static_cast<int64_t>(std::llround(imu_rate_hz / config.rate_hz));
   const double T = 1.0 / config.rate_hz;
   const bool gm = !config.position_gauss_markov_sigma_ned_m.isZero(0.0);
-  gm_a_ = gm ? std::exp(-T / config.position_gauss_markov_tau_s) : 0.0;
+  gm_a_ = gm ? math::Exp(-T / config.position_gauss_markov_tau_s) : 0.0;
   for (uint8_t axis = 0; axis < 3; ++axis) {
     white_position_[axis] =
         RandomStream(seed, run_index, {SensorId::kGnss, axis, ErrorTerm::kWhiteNoise, 0});
@@ -150,7 +151,7 @@ bool GnssSimulator::Measure(int64_t k, const NavState& truth, const Vector3d& om
   const double L = llh.lat_rad, h = llh.h_m;
   out->t_s = truth.t_s;
   out->llh.lat_rad = L + dr.x() / (env_.MeridianRadiusAt(L) + h);
-  out->llh.lon_rad = llh.lon_rad + dr.y() / ((env_.TransverseRadiusAt(L) + h) * std::cos(L));
+  out->llh.lon_rad = llh.lon_rad + dr.y() / ((env_.TransverseRadiusAt(L) + h) * math::Cos(L));
   out->llh.h_m = h - dr.z();
   out->v_eb_n = v + dv;
   return true;

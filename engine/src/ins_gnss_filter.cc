@@ -6,6 +6,7 @@
 #include <string>
 
 #include "driftlab/attitude.h"
+#include "driftlab/elementary.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/trajectory.h"
 
@@ -96,7 +97,8 @@ void InsGnssFilter::SyncCovariance() {
   propagator_.Propagate(ref, f_b, T, theta_sum_ / T);
   // Gauss-Markov estimates decay as their conditional mean.
   if (inverse_tau_.size() > 0 && inverse_tau_.any()) {
-    sensor_estimate_.array() *= (-T * inverse_tau_.array()).exp();
+    sensor_estimate_.array() *=
+        (-T * inverse_tau_.array()).unaryExpr([](double v) { return math::Exp(v); });
     RefreshCorrections();
   }
   f_n_sum_.setZero();
@@ -155,7 +157,7 @@ void InsGnssFilter::Correct(const Eigen::Matrix<double, M, Eigen::Dynamic>& H,
   const Matrix3d C = c.C_b_n();
   const double L = c.llh.lat_rad, h = c.llh.h_m;
   c.llh.lat_rad -= x[0] / (env_.MeridianRadiusAt(L) + h);
-  c.llh.lon_rad -= x[1] / ((env_.TransverseRadiusAt(L) + h) * std::cos(L));
+  c.llh.lon_rad -= x[1] / ((env_.TransverseRadiusAt(L) + h) * math::Cos(L));
   c.llh.h_m += x[2];
   c.v_eb_n -= x.segment<3>(kErrVelocity);
   c.q_b_n = Quaterniond(RotationVectorToDcm(-x.segment<3>(kErrAttitude)) * C);
@@ -324,8 +326,9 @@ void Chi2MeanBounds95(int dof, int n, double* low, double* high) {
   const double k = static_cast<double>(dof) * n;
   const double z = 1.959963984540054;  // standard normal 97.5 % quantile
   const double a = 2.0 / (9.0 * k);
-  *low = k * std::pow(1.0 - a - z * std::sqrt(a), 3) / n;
-  *high = k * std::pow(1.0 - a + z * std::sqrt(a), 3) / n;
+  const double lo = 1.0 - a - z * std::sqrt(a), hi = 1.0 - a + z * std::sqrt(a);
+  *low = k * (lo * lo * lo) / n;
+  *high = k * (hi * hi * hi) / n;
 }
 
 }  // namespace driftlab

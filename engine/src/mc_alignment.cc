@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "driftlab/attitude.h"
+#include "driftlab/elementary.h"
 #include "driftlab/random.h"
 #include "mc_internal.h"
 
@@ -33,7 +34,7 @@ NavState PerturbedStart(const SharedTruth& s, const MonteCarloSpec& spec, uint32
   const double L = init.llh.lat_rad;
   const double h = init.llh.h_m;
   init.llh.lat_rad += dr.x() / (s.env.MeridianRadiusAt(L) + h);
-  init.llh.lon_rad += dr.y() / ((s.env.TransverseRadiusAt(L) + h) * std::cos(L));
+  init.llh.lon_rad += dr.y() / ((s.env.TransverseRadiusAt(L) + h) * math::Cos(L));
   init.llh.h_m -= dr.z();
   init.v_eb_n += dv;
   return init;
@@ -50,12 +51,13 @@ NavState NedStartState(const SharedTruth& s, const MonteCarloSpec& spec, uint32_
     const Eigen::Vector3d f = sum_dv / T;
     const Eigen::Vector3d w = sum_dtheta / T;
     EulerAngles e;
-    e.roll_rad = std::atan2(-f.y(), -f.z());
-    e.pitch_rad = std::atan(f.x() / std::hypot(f.y(), f.z()));
+    e.roll_rad = math::Atan2(-f.y(), -f.z());
+    e.pitch_rad = math::Atan(f.x() / math::Hypot(f.y(), f.z()));
     if (gyrocompass) {
-      const double sr = std::sin(e.roll_rad), cr = std::cos(e.roll_rad);
-      const double sp = std::sin(e.pitch_rad), cp = std::cos(e.pitch_rad);
-      e.yaw_rad = std::atan2(-w.y() * cr + w.z() * sr, w.x() * cp + (w.y() * sr + w.z() * cr) * sp);
+      const double sr = math::Sin(e.roll_rad), cr = math::Cos(e.roll_rad);
+      const double sp = math::Sin(e.pitch_rad), cp = math::Cos(e.pitch_rad);
+      e.yaw_rad =
+          math::Atan2(-w.y() * cr + w.z() * sr, w.x() * cp + (w.y() * sr + w.z() * cr) * sp);
     } else {
       const Eigen::Vector3d heading_sigma(0.0, 0.0, *spec.alignment.heading_sigma_rad);
       e.yaw_rad = WrapPi(s.truth_start.euler().yaw_rad +
@@ -93,10 +95,11 @@ bool UseGyrocompass(const MonteCarloSpec& spec, const SharedTruth& truth) {
 
 double PredictedGyrocompassHeadingSigma(const TriadErrorParams& gyro, double L_b, double duration_s,
                                         double omega_ie_rad_per_s) {
-  const double horizontal_rate = omega_ie_rad_per_s * std::cos(L_b);
+  const double horizontal_rate = omega_ie_rad_per_s * math::Cos(L_b);
   if (!(std::abs(horizontal_rate) > 0.0)) return std::numeric_limits<double>::infinity();
   // 0.664 = sqrt(2 ln 2 / pi), the flicker floor of the Allan deviation (sensor_params.h).
-  const double flicker = std::sqrt(2.0 * std::log(2.0) / M_PI) * gyro.bias_flicker.bias_instability;
+  const double flicker =
+      std::sqrt(2.0 * math::Log(2.0) / M_PI) * gyro.bias_flicker.bias_instability;
   const double fixed = gyro.fixed_bias.cwiseAbs().maxCoeff();
   const double T = duration_s;
   const double bias2 = fixed * fixed + gyro.turn_on_bias_sigma * gyro.turn_on_bias_sigma +

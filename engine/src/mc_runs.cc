@@ -8,6 +8,7 @@
 
 #include "driftlab/aiding.h"
 #include "driftlab/complementary_filter.h"
+#include "driftlab/elementary.h"
 #include "driftlab/ins_gnss_filter.h"
 #include "driftlab/sensors.h"
 #include "mc_internal.h"
@@ -82,7 +83,7 @@ class EkfNavigator {
       baro_sigma_m_ =
           s.ekf_noise.barometer_bias_sigma_m > 0.0
               ? aiding_.barometer->noise_sigma_m
-              : std::hypot(aiding_.barometer->noise_sigma_m, aiding_.barometer->bias.sigma);
+              : math::Hypot(aiding_.barometer->noise_sigma_m, aiding_.barometer->bias.sigma);
     }
     if (aiding_.zupt) zupt_.emplace(*aiding_.zupt, s.rate_hz, spec.seed, run);
   }

@@ -5,10 +5,12 @@
 // W > 1 the errors of a lockstep group's W runs against one truth at once (the lane kernels,
 // lockstep_ned_{baseline,avx2,avx512}.cc), so each operation exists once and every path gives
 // the same bits.
-// Arithmetic is lane-wise IEEE (-ffp-contract=off); atan2, asin, hypot and remainder are the C
-// library's, called per lane with the same arguments as the scalar code (lanes whose remainder
-// would return its argument unchanged skip the call). As lane_math.h: internal linkage, no Eigen
-// and no standard-library templates (a kernel file shares no inline code with the rest).
+// Arithmetic is lane-wise IEEE (-ffp-contract=off); atan2, asin and hypot are the engine's own
+// (lane_math.h: the same bits on every machine), remainder the C library's (an exact operation,
+// the same in every correct implementation), called per lane with the same arguments as the
+// scalar code (lanes whose remainder would return its argument unchanged skip the call). As
+// lane_math.h: internal linkage, no Eigen and no standard-library templates (a kernel file shares
+// no inline code with the rest).
 #pragma once
 
 #include "lane_math.h"
@@ -86,10 +88,10 @@ inline void PositionError(D<W> lat, D<W> lon, D<W> h, double truth_lat, double t
 // (Groves (2.17): the inverse of the Euler-to-DCM (2.22), pitch from the clamped (2,0)).
 template <int W>
 inline void EulerOfDcm(D<W> c00, D<W> c10, D<W> c20, D<W> c21, D<W> c22, D<W> (&euler)[3]) {
-  euler[0] = PerLane<W>(c21, c22, [](double y, double x) { return __builtin_atan2(y, x); });
+  euler[0] = PerLane<W>(c21, c22, [](double y, double x) { return lane_math::Atan2(y, x); });
   euler[1] =
-      -PerLane<W>(lane_math::Clamp<W>(c20, -1.0, 1.0), [](double s) { return __builtin_asin(s); });
-  euler[2] = PerLane<W>(c10, c00, [](double y, double x) { return __builtin_atan2(y, x); });
+      -PerLane<W>(lane_math::Clamp<W>(c20, -1.0, 1.0), [](double s) { return lane_math::Asin(s); });
+  euler[2] = PerLane<W>(c10, c00, [](double y, double x) { return lane_math::Atan2(y, x); });
 }
 
 // Those five elements of C_b_n from the quaternion q_b_n = (w, x, y, z), with the operations of
@@ -107,7 +109,7 @@ inline void EulerOfQuaternion(D<W> w, D<W> x, D<W> y, D<W> z, D<W> (&euler)[3]) 
 // x86-64 / arm64 build: sqrt of (x^2 + y^2) + z^2, its two-lane packet reduced first).
 template <int W>
 inline D<W> Horizontal(D<W> n, D<W> e) {
-  return PerLane<W>(n, e, [](double a, double b) { return __builtin_hypot(a, b); });
+  return PerLane<W>(n, e, [](double a, double b) { return lane_math::Hypot(a, b); });
 }
 template <int W>
 inline D<W> Norm3(D<W> x, D<W> y, D<W> z) {

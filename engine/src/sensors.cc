@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <numbers>
 
+#include "driftlab/elementary.h"
 #include "driftlab/spec_error.h"
 // The lane kernel has internal linkage (its own anonymous namespace): this file's Kernel<1> is
 // compiled with this file's options only and shares no inline code with the kernel files built
@@ -53,7 +54,7 @@ std::string Index(const std::string& field, int i) { return field + "[" + std::t
 // the start value; see the derivation in TriadErrorSimulator's constructor). The closed form
 // cancels x to x^3 for small x, so the series is used for x < 0.1.
 double GaussMarkovIntegralShape(double x) {
-  if (x >= 0.1) return x + 2.0 * std::expm1(-x) - 0.5 * std::expm1(-2.0 * x);
+  if (x >= 0.1) return x + 2.0 * math::Expm1(-x) - 0.5 * math::Expm1(-2.0 * x);
   double sum = 0.0;
   double power_over_factorial = x * x / 2.0;  // x^n / n! at n = 2
   double two_pow = 2.0;                       // 2^(n-1) at n = 2
@@ -71,7 +72,7 @@ double GaussMarkovIntegralShape(double x) {
 //   g(x) = (2x - (3 - 4 e^-x + e^-2x)) / x^2 = sum_{n>=3} (-1)^(n+1) (2^n - 4) x^(n-2) / n!
 double GaussMarkovAllanShape(double x) {
   if (x >= 0.1) {
-    const double h = -4.0 * std::expm1(-x) + std::expm1(-2.0 * x);  // 3 - 4 e^-x + e^-2x
+    const double h = -4.0 * math::Expm1(-x) + math::Expm1(-2.0 * x);  // 3 - 4 e^-x + e^-2x
     return (2.0 * x - h) / (x * x);
   }
   double sum = 0.0;
@@ -166,9 +167,9 @@ double GaussMarkovAllanVariance(double sigma, double tau_s, double tau_avg_s) {
 std::vector<GaussMarkovComponent> DesignFlickerApproximation(const FlickerParams& params) {
   std::vector<GaussMarkovComponent> components;
   if (!(params.bias_instability > 0.0)) return components;
-  const double log_lo = std::log(params.tau_min_s / 4.0);
-  const double log_hi = std::log(2.0 * params.tau_max_s);
-  const double max_log_ratio = 0.5 * std::log(10.0);  // two components per decade
+  const double log_lo = math::Log(params.tau_min_s / 4.0);
+  const double log_hi = math::Log(2.0 * params.tau_max_s);
+  const double max_log_ratio = 0.5 * math::Log(10.0);  // two components per decade
   const int n = static_cast<int>(std::ceil((log_hi - log_lo) / max_log_ratio - 1e-9)) + 1;
   const double log_ratio = (log_hi - log_lo) / (n - 1);
   const double variance =
@@ -178,7 +179,7 @@ std::vector<GaussMarkovComponent> DesignFlickerApproximation(const FlickerParams
   for (int j = 0; j < n; ++j) {
     const bool end = (j == 0 || j == n - 1);
     components[j].sigma = std::sqrt(end ? end_variance : variance);
-    components[j].tau_s = std::exp(log_lo + j * log_ratio);
+    components[j].tau_s = math::Exp(log_lo + j * log_ratio);
   }
   return components;
 }
@@ -227,10 +228,10 @@ TriadJobConstants ComposeTriadJobConstants(const TriadErrorParams& params, doubl
     const double sigma = params.bias_gauss_markov.sigma;
     const double T = params.bias_gauss_markov.tau_s;
     const double x = dt / T;
-    const double one_minus_a = -std::expm1(-x);
-    const double one_minus_a2 = -std::expm1(-2.0 * x);
+    const double one_minus_a = -math::Expm1(-x);
+    const double one_minus_a2 = -math::Expm1(-2.0 * x);
     job.gauss_markov = true;
-    job.gm_decay = std::exp(-x);
+    job.gm_decay = math::Exp(-x);
     job.gm_drive_sigma = sigma * std::sqrt(one_minus_a2);
     job.gm_mean_gain = T * one_minus_a;
     job.gm_integral_w1_gain = sigma * sigma * T * one_minus_a * one_minus_a / job.gm_drive_sigma;
@@ -271,8 +272,8 @@ TriadJobConstants ComposeTriadJobConstants(const TriadErrorParams& params, doubl
     while (m < 40 && std::ldexp(dt, m + 1) <= T / 32.0) ++m;
     const double h = std::ldexp(dt, m);
     job.flicker_period_log2[j] = m;
-    job.flicker_decay[j] = std::exp(-h / T);
-    job.flicker_drive_sigma[j] = job.flicker[j].sigma * std::sqrt(-std::expm1(-2.0 * h / T));
+    job.flicker_decay[j] = math::Exp(-h / T);
+    job.flicker_drive_sigma[j] = job.flicker[j].sigma * std::sqrt(-math::Expm1(-2.0 * h / T));
   }
   job.range = params.range;
   job.quantization = params.quantization;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "driftlab/elementary.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab {
@@ -24,7 +25,7 @@ double GammaSeries(double a, double x) {
     sum += term;
     if (std::abs(term) < std::abs(sum) * kEps) break;
   }
-  return sum * std::exp(-x + a * std::log(x) - std::lgamma(a));
+  return sum * math::Exp(-x + a * math::Log(x) - math::LgammaPositive(a));
 }
 
 // Q(a, x) = 1 - P(a, x) by the continued fraction NR 6.2.7, modified Lentz (NR 5.2).
@@ -45,14 +46,14 @@ double GammaContinuedFraction(double a, double x) {
     h *= delta;
     if (std::abs(delta - 1.0) < kEps) break;
   }
-  return std::exp(-x + a * std::log(x) - std::lgamma(a)) * h;
+  return math::Exp(-x + a * math::Log(x) - math::LgammaPositive(a)) * h;
 }
 
 // Standard normal quantile, Abramowitz & Stegun 26.2.23 (|error| < 4.5e-4); used only as the
 // starting point of the chi-square quantile iteration.
 double NormalQuantileApprox(double p) {
   const double q = p < 0.5 ? p : 1.0 - p;
-  const double t = std::sqrt(-2.0 * std::log(q));
+  const double t = std::sqrt(-2.0 * math::Log(q));
   const double z = t - (2.515517 + 0.802853 * t + 0.010328 * t * t) /
                            (1.0 + 1.432788 * t + 0.189269 * t * t + 0.001308 * t * t * t);
   return p < 0.5 ? -z : z;
@@ -66,6 +67,19 @@ double RegularizedGammaP(double a, double x) {
   return 1.0 - GammaContinuedFraction(a, x);
 }
 
+double RegularizedGammaQ(double a, double x) {
+  if (x <= 0.0) return 1.0;
+  if (std::isinf(x)) return 0.0;
+  if (x < a + 1.0) return 1.0 - GammaSeries(a, x);
+  return GammaContinuedFraction(a, x);
+}
+
+double NormalCdf(double z) {
+  if (!(z == z)) return z;
+  const double half_q = 0.5 * RegularizedGammaQ(0.5, 0.5 * z * z);  // P(|Z| > |z|) / 2
+  return z < 0.0 ? half_q : 1.0 - half_q;
+}
+
 double ChiSquareCdf(double x, double k) { return RegularizedGammaP(0.5 * k, 0.5 * x); }
 
 double ChiSquareQuantile(double p, double nu) {
@@ -76,7 +90,8 @@ double ChiSquareQuantile(double p, double nu) {
   auto cdf = [a](double x) { return RegularizedGammaP(a, x / 2.0); };
   // Wilson & Hilferty (1931): chi2_p(nu) ~ nu (1 - 2/(9 nu) + z_p sqrt(2/(9 nu)))^3.
   const double k = 2.0 / (9.0 * nu);
-  double x = nu * std::pow(std::max(1.0 - k + NormalQuantileApprox(p) * std::sqrt(k), 1e-3), 3);
+  const double c = std::max(1.0 - k + NormalQuantileApprox(p) * std::sqrt(k), 1e-3);
+  double x = nu * (c * c * c);
   // Bracket the root of cdf(x) - p, then safeguarded Newton steps (bisection when a step leaves
   // the bracket). The density is f(x) = exp((a - 1) ln x - x/2 - a ln 2 - lgamma(a)).
   double lo = 0.0, hi = std::max(x, 1.0);
@@ -92,8 +107,8 @@ double ChiSquareQuantile(double p, double nu) {
     } else {
       hi = x;
     }
-    const double density =
-        std::exp((a - 1.0) * std::log(x) - x / 2.0 - a * std::log(2.0) - std::lgamma(a));
+    const double density = math::Exp((a - 1.0) * math::Log(x) - x / 2.0 - a * math::Log(2.0) -
+                                     math::LgammaPositive(a));
     double next = density > 0.0 ? x - f / density : 0.5 * (lo + hi);
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
     if (std::abs(next - x) <= 1e-14 * x || hi - lo <= 1e-15 * hi) return next;

@@ -22,6 +22,7 @@
 #include <variant>
 #include <vector>
 
+#include "driftlab/elementary.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab {
@@ -118,8 +119,7 @@ class TrigMemo {
     Entry& e = entries_[slot];
     const uint64_t bits = std::bit_cast<uint64_t>(x);
     if (!e.valid || e.bits != bits) {
-      e.s = std::sin(x);
-      e.c = std::cos(x);
+      math::SinCos(x, &e.s, &e.c);
       e.bits = bits;
       e.valid = true;
     }
@@ -141,8 +141,7 @@ void SinCosVia(TrigMemo* memo, TrigMemo::Slot slot, double x, double* s, double*
   if (memo != nullptr) {
     memo->SinCos(slot, x, s, c);
   } else {
-    *s = std::sin(x);
-    *c = std::cos(x);
+    math::SinCos(x, s, c);
   }
 }
 
@@ -163,7 +162,7 @@ struct Wave {
       *x = *dx = *ddx = 0.0;
       return;
     }
-    const double sn = std::sin(omega * s + phase), cs = std::cos(omega * s + phase);
+    const double sn = math::Sin(omega * s + phase), cs = math::Cos(omega * s + phase);
     *x = amplitude * sn;
     *dx = amplitude * omega * cs;
     *ddx = -amplitude * omega * omega * sn;
@@ -212,14 +211,14 @@ struct TrackPiece {
     if (pitch_follows) {
       // gamma = atan2(u, V), u = -v_D:  d gamma/dt = (V u' - u V') / (V^2 + u^2).
       const double u = -vD, du = -dvD, r2 = V * V + u * u;
-      pitch += std::atan2(u, V);
+      pitch += math::Atan2(u, V);
       if (r2 > 0.0) dpitch = (V * du - u * dV) / r2;
     }
     double roll = roll_offset, droll = 0.0;
     if (coordinated) {
       // phi = atan(V chi' / g):  d phi/dt = (V' chi' + V chi'') / g / (1 + (V chi' / g)^2).
       const double x = V * dchi / g_m_per_s2;
-      roll += std::atan(x);
+      roll += math::Atan(x);
       droll = (dV * dchi + V * ddchi) / g_m_per_s2 / (1.0 + x * x);
     }
     double yaw = yaw_offset + chi, dyaw = dchi;
@@ -228,7 +227,7 @@ struct TrackPiece {
     double ddv_up = 0.0;
     if (ship) {
       // Envelope e = mean + amplitude cos(omega s) (raised-cosine ramps, 1 in between).
-      const double ec = std::cos(envelope_omega * s), es = std::sin(envelope_omega * s);
+      const double ec = math::Cos(envelope_omega * s), es = math::Sin(envelope_omega * s);
       const double e = envelope_mean + envelope_amplitude * ec;
       const double de = -envelope_amplitude * envelope_omega * es;
       const double dde = -envelope_amplitude * envelope_omega * envelope_omega * ec;
@@ -361,8 +360,8 @@ class Planner {
       *v_down = state_.v_down;
       return;
     }
-    *V = std::hypot(state_.v_eb_n.x(), state_.v_eb_n.y());
-    *chi = *V > 0.0 ? std::atan2(state_.v_eb_n.y(), state_.v_eb_n.x()) : state_.euler.yaw_rad;
+    *V = math::Hypot(state_.v_eb_n.x(), state_.v_eb_n.y());
+    *chi = *V > 0.0 ? math::Atan2(state_.v_eb_n.y(), state_.v_eb_n.x()) : state_.euler.yaw_rad;
     *v_down = state_.v_eb_n.z();
   }
 
@@ -375,9 +374,9 @@ class Planner {
     p.coordinated = motion_.vehicle.coordinated_turns;
     p.g_m_per_s2 = g_m_per_s2_;
     p.yaw_offset = state_.euler.yaw_rad - chi;
-    p.pitch_offset = state_.euler.pitch_rad - (p.pitch_follows ? std::atan2(-v_down, V) : 0.0);
+    p.pitch_offset = state_.euler.pitch_rad - (p.pitch_follows ? math::Atan2(-v_down, V) : 0.0);
     p.roll_offset =
-        state_.euler.roll_rad - (p.coordinated ? std::atan(V * dchi0 / g_m_per_s2_) : 0.0);
+        state_.euler.roll_rad - (p.coordinated ? math::Atan(V * dchi0 / g_m_per_s2_) : 0.0);
     return p;
   }
 
@@ -398,7 +397,7 @@ class Planner {
     state_.V = p.speed.Value(duration);
     state_.chi = p.chi0 + (p.chi1 + p.chi2 * duration) * duration;
     if (p.zigzag.amplitude != 0.0) {
-      state_.chi += p.zigzag.amplitude * std::sin(p.zigzag.omega * duration + p.zigzag.phase);
+      state_.chi += p.zigzag.amplitude * math::Sin(p.zigzag.omega * duration + p.zigzag.phase);
     }
     state_.v_down = p.v_down.Value(duration);
   }
@@ -744,7 +743,7 @@ class Planner {
     }
     // The segment ends with the envelope at zero: back on the base motion exactly.
     state_.euler = start.euler;
-    state_.v_eb_n = Vector3d(V * std::cos(chi), V * std::sin(chi), vD);
+    state_.v_eb_n = Vector3d(V * math::Cos(chi), V * math::Sin(chi), vD);
     state_.has_track = true;
     state_.V = V;
     state_.chi = chi;

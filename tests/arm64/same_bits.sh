@@ -6,8 +6,8 @@
 #     sensor and mechanization steps, the statistics' error components) built for this machine and
 #     for arm64 with the engine's options (-ffp-contract=off; the kernel files' -fno-math-errno
 #     -fvect-cost-model=dynamic), the arm64 one run under qemu: both print the same digests, line
-#     for line; lines marked "libm" (results of the C library's atan2, asin, hypot) are reported,
-#     not required (another architecture's C library may round them differently).
+#     for line (the C library's results, which differ between x86-64 and arm64 for log, hypot,
+#     exp2 and cbrt, are not used).
 #  2. every engine source through the arm64 compiler with the engine's warnings as errors
 #     (-fsyntax-only: parsing, templates instantiated; Eigen's and oneTBB's headers are
 #     architecture-independent), and the three lockstep kernel files compiled to arm64 code.
@@ -46,17 +46,12 @@ cat "$work/host.txt"
 echo "--- arm64 (qemu-aarch64-static)"
 cat "$work/arm64.txt"
 if [ "$(wc -l < "$work/host.txt")" -lt 10 ]; then
-  echo "FAILED: lane_bits printed $(wc -l < "$work/host.txt") lines, expected 10" >&2
+  echo "FAILED: lane_bits printed $(wc -l < "$work/host.txt") lines, expected 10 or more" >&2
   exit 1
 fi
-if ! diff <(grep -v '^libm ' "$work/host.txt") <(grep -v '^libm ' "$work/arm64.txt"); then
+if ! diff "$work/host.txt" "$work/arm64.txt"; then
   echo "FAILED: the lane code gives different bits on arm64 (lines above)" >&2
   exit 1
-fi
-if diff -q <(grep '^libm ' "$work/host.txt") <(grep '^libm ' "$work/arm64.txt") > /dev/null; then
-  echo "libm lines: equal on both"
-else
-  echo "libm lines: differ (the C libraries round atan2/asin/hypot differently; not required)"
 fi
 
 echo "--- engine sources through $cross"

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "driftlab/allan.h"  // ChiSquareQuantile
+#include "driftlab/elementary.h"
 
 namespace driftlab::jobspec {
 namespace {
@@ -101,7 +102,7 @@ ConsistencyVerdict AssessConsistency(const v1::JobResult& result, double alpha) 
         if (nees > band.high) ++v.nees_above;
         if (nees < band.low) ++v.nees_below;
         // Distance from the band's geometric centre in log ratio: the epoch farthest from it.
-        const double distance = std::abs(std::log(nees / std::sqrt(band.low * band.high)));
+        const double distance = std::abs(math::Log(nees / std::sqrt(band.low * band.high)));
         if (std::isfinite(distance) && distance > worst) {
           worst = distance;
           v.worst_t_s = e.t_s();

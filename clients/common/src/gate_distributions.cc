@@ -4,6 +4,9 @@
 #include <cmath>
 #include <limits>
 
+#include "driftlab/elementary.h"
+#include "driftlab/special_functions.h"
+
 namespace driftlab::jobspec {
 namespace {
 
@@ -64,16 +67,16 @@ double RegularizedBeta(double a, double b, double x) {
   if (x <= 0.0) return 0.0;
   if (x >= 1.0) return 1.0;
   // Prefactor x^a (1-x)^b / (a B(a, b)) (NR 6.4.5), in logs for large a, b.
-  const double log_front =
-      std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x);
+  const double log_front = math::LgammaPositive(a + b) - math::LgammaPositive(a) -
+                           math::LgammaPositive(b) + a * math::Log(x) + b * math::Log1p(-x);
   // The fraction converges fast for x < (a + 1) / (a + b + 2); else use the symmetry (NR 6.4).
   if (x < (a + 1.0) / (a + b + 2.0)) {
-    return std::exp(log_front) * BetaContinuedFraction(a, b, x) / a;
+    return math::Exp(log_front) * BetaContinuedFraction(a, b, x) / a;
   }
-  return 1.0 - std::exp(log_front) * BetaContinuedFraction(b, a, 1.0 - x) / b;
+  return 1.0 - math::Exp(log_front) * BetaContinuedFraction(b, a, 1.0 - x) / b;
 }
 
-double NormalCdf(double z) { return 0.5 * std::erfc(-z / std::sqrt(2.0)); }
+double NormalCdf(double z) { return driftlab::NormalCdf(z); }  // the engine's (special_functions.h)
 
 double NormalQuantile(double p) {
   if (p <= 0.0) return -std::numeric_limits<double>::infinity();

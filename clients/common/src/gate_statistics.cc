@@ -8,6 +8,7 @@
 #include <numeric>
 #include <random>
 
+#include "driftlab/elementary.h"
 #include "driftlab/jobspec/gate_distributions.h"
 
 namespace driftlab::jobspec {
@@ -110,10 +111,11 @@ struct BinomialTails {
 
 BinomialTails Tails(long n, double p) {
   std::vector<double> pmf(static_cast<size_t>(n) + 1);
-  const double log_n = std::lgamma(n + 1.0);
+  const double log_n = math::LgammaPositive(n + 1.0);
   for (long i = 0; i <= n; ++i) {
-    pmf[static_cast<size_t>(i)] = std::exp(log_n - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) +
-                                           i * std::log(p) + (n - i) * std::log1p(-p));
+    pmf[static_cast<size_t>(i)] =
+        math::Exp(log_n - math::LgammaPositive(i + 1.0) - math::LgammaPositive(n - i + 1.0) +
+                  i * math::Log(p) + (n - i) * math::Log1p(-p));
   }
   BinomialTails t;
   t.lower.assign(static_cast<size_t>(n) + 2, 0.0);

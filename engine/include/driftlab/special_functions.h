@@ -14,6 +14,16 @@ namespace driftlab {
 // 9 N or more degrees of freedom of a NEES average over N = 1e6 runs. About 1e-12 relative.
 double RegularizedGammaP(double a, double x);
 
+// Q(a, x) = 1 - P(a, x), computed directly (the continued fraction for x >= a + 1, where 1 - P
+// would lose the tail's relative precision).
+double RegularizedGammaQ(double a, double x);
+
+// Standard normal distribution function Phi(z) = erfc(-z / sqrt 2) / 2 = P or Q(1/2, z^2/2) / 2
+// (A&S 26.2.30, 6.5.17), from the functions above (the engine's own exp and log inside, so the
+// same bits on every machine, which the C library's erfc is not); ~1e-12 relative, tails
+// included.
+double NormalCdf(double z);
+
 // Chi-square with k (real, > 0) degrees of freedom: P(X <= x) = P(k / 2, x / 2) (A&S 26.4.19).
 double ChiSquareCdf(double x, double k);
 
