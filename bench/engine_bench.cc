@@ -62,6 +62,21 @@ void BM_Generator(benchmark::State& state) {
 }
 BENCHMARK(BM_Generator)->Unit(benchmark::kMillisecond);
 
+// The same without the point samples (what the free-inertial NED runs' shared truth computes).
+void BM_GeneratorIncrementsOnly(benchmark::State& state) {
+  const MotionSpec motion = CarDrive(EarthModel::kWgs84);
+  int64_t samples = 0;
+  for (auto _ : state) {
+    TrajectoryGenerator generator(motion, kRate_hz);
+    generator.set_point_samples(false);
+    TrajectorySample sample;
+    while (generator.Next(&sample)) benchmark::DoNotOptimize(sample);
+    samples += generator.step();
+  }
+  state.SetItemsProcessed(samples);
+}
+BENCHMARK(BM_GeneratorIncrementsOnly)->Unit(benchmark::kMillisecond);
+
 void BM_MechanizationA(benchmark::State& state) {
   const Trajectory& trajectory = CarTrajectory(EarthModel::kWgs84);
   NedMechanizationOptions options;

@@ -98,6 +98,9 @@ void StreamSharedTruth(const MonteCarloSpec& spec, bool keep_imu, TrajectoryGene
   };
   keep_truth(0, s.truth0);
   if (stream != nullptr) stream->Publish(0);
+  // The point samples only for mechanization B and the complementary filter (a sixth of the
+  // generator's work otherwise spent on values nobody reads).
+  generator.set_point_samples(keep_imu && point_samples);
   TrajectorySample sample;
   while (generator.Next(&sample)) {
     const int64_t k = generator.step();

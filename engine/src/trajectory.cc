@@ -1280,6 +1280,7 @@ struct TrajectoryGenerator::Impl {
   std::vector<double> breakpoints;
   std::vector<std::pair<double, double>> gps_invisible_s;
   TrigMemo trig_memo;  // Next's path only (IsStaticAt and the planner evaluate without it)
+  bool point_samples = true;  // Next computes out->sample (set_point_samples)
   NavState initial;
   ImuSample initial_sample;
   // Integration state at t = step / rate_hz: (L, lambda, h) as an unevaluated sum llh + llh_lo.
@@ -1517,9 +1518,11 @@ bool TrajectoryGenerator::Next(TrajectorySample* out) {
   out->truth.llh = Llh{m.llh.x(), WrapPi(m.llh.y()), m.llh.z()};
   out->truth.v_eb_n = k.v_eb_n;
   out->truth.q_b_n = EulerToQuaternion(k.euler, &m.trig_memo);
-  m.PointSample(k, m.llh, &out->sample);
+  if (m.point_samples) m.PointSample(k, m.llh, &out->sample);
   return true;
 }
+
+void TrajectoryGenerator::set_point_samples(bool on) { impl_->point_samples = on; }
 
 Trajectory GenerateTrajectory(const MotionSpec& motion, double rate_hz) {
   TrajectoryGenerator generator(motion, rate_hz);

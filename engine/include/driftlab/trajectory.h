@@ -243,6 +243,11 @@ class TrajectoryGenerator {
 
   // Advances one output step; false when the trajectory has ended.
   bool Next(TrajectorySample* out);
+  // Whether Next computes the point sample (TrajectorySample::sample; default true). A caller that
+  // only uses the increments and the truth (the free-inertial NED runs) turns it off: the point
+  // sample is about a sixth of the generator's work, and Next then leaves out->sample as it is.
+  // Nothing else changes.
+  void set_point_samples(bool on);
   // Steps produced so far.
   int64_t step() const;
 
