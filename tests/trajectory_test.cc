@@ -152,6 +152,32 @@ MotionSpec ShipAndTurn() {
   return m;
 }
 
+// set_point_samples(false) leaves the point samples out and changes nothing else: the truth and
+// the increments are the same bits as with them (exact equality: the same operations).
+TEST(TrajectoryGenerator, WithoutPointSamplesTruthAndIncrementsAreTheSameBits) {
+  const MotionSpec m = ShipAndTurn();
+  TrajectoryGenerator with(m, 100.0), without(m, 100.0);
+  without.set_point_samples(false);
+  TrajectorySample a, b;
+  b.sample.omega_ib_b = Vector3d(7.0, 8.0, 9.0);  // left as it is by Next
+  int64_t steps = 0;
+  while (with.Next(&a)) {
+    ASSERT_TRUE(without.Next(&b));
+    ++steps;
+    ASSERT_EQ(a.truth.llh.lat_rad, b.truth.llh.lat_rad) << steps;
+    ASSERT_EQ(a.truth.llh.lon_rad, b.truth.llh.lon_rad) << steps;
+    ASSERT_EQ(a.truth.llh.h_m, b.truth.llh.h_m) << steps;
+    ASSERT_EQ(a.truth.v_eb_n, b.truth.v_eb_n) << steps;
+    ASSERT_EQ(a.truth.q_b_n.coeffs(), b.truth.q_b_n.coeffs()) << steps;
+    ASSERT_EQ(a.increment.delta_theta_ib_b, b.increment.delta_theta_ib_b) << steps;
+    ASSERT_EQ(a.increment.delta_v_ib_b, b.increment.delta_v_ib_b) << steps;
+  }
+  EXPECT_FALSE(without.Next(&b));
+  EXPECT_EQ(steps, with.num_steps());
+  EXPECT_EQ(b.sample.omega_ib_b, Vector3d(7.0, 8.0, 9.0));
+  EXPECT_NE(a.sample.omega_ib_b, Vector3d(7.0, 8.0, 9.0));
+}
+
 TEST(TrajectoryGenerator, IncrementsAt100HzEqualSummedIncrementsAt2000Hz) {
   const MotionSpec m = ShipAndTurn();
   const Trajectory coarse = GenerateTrajectory(m, 100.0);
