@@ -1,6 +1,6 @@
-// Fit times of issue 5 ("Measure"): the multi-position IMU calibration of a 30-minute 100 Hz
-// tumble and the Allan noise-model fit of a 10-hour 100 Hz static recording, both through the
-// library cores behind the CLI and the gRPC service (jobspec/calibration_job.h).
+// Fit times: the multi-position IMU calibration of a 30-minute 100 Hz tumble and the Allan
+// noise-model fit of a 10-hour 100 Hz static recording, both through the library cores behind the
+// CLI and the gRPC service (app/calibration_job.h).
 //
 //   BM_CalibrateTumble30Min/0: RunCalibration("imu") on the table in memory (static detection,
 //     accelerometer fit, gyro fit with its sample-by-sample attitude integration, covariances).
@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "driftlab/app/calibration_job.h"
 #include "driftlab/calib/tumble.h"
-#include "driftlab/jobspec/calibration_job.h"
 #include "driftlab/presets.h"
 #include "driftlab/sensors.h"
 
@@ -40,8 +40,8 @@ calib::TumbleSpec ThirtyMinuteSpec() {
   return spec;
 }
 
-const jobspec::NumericTable& TumbleTable() {
-  static const jobspec::NumericTable table = [] {
+const app::NumericTable& TumbleTable() {
+  static const app::NumericTable table = [] {
     ImuErrorModel model = FindImuPreset("tactical");
     model.gyro_g_sensitivity.setZero();
     for (TriadErrorParams* t : {&model.gyro, &model.accel}) {
@@ -50,7 +50,7 @@ const jobspec::NumericTable& TumbleTable() {
       t->random_walk = 0.0;
     }
     const calib::Tumble tumble = calib::SimulateTumble(ThirtyMinuteSpec(), model, 5, 0);
-    jobspec::NumericTable t;
+    app::NumericTable t;
     t.columns = {"t_s", "gx", "gy", "gz", "ax", "ay", "az"};
     const calib::RawImuRecording& r = tumble.recording;
     t.values.reserve(7 * r.size());
@@ -68,7 +68,7 @@ std::string TumbleCsv() {
   static const std::string path = [] {
     const std::string p =
         (std::filesystem::temp_directory_path() / "driftlab_bench_tumble_30min.csv").string();
-    const jobspec::NumericTable& t = TumbleTable();
+    const app::NumericTable& t = TumbleTable();
     std::FILE* f = std::fopen(p.c_str(), "w");
     std::fputs("t_s,gx,gy,gz,ax,ay,az\n", f);
     for (size_t k = 0; k < t.rows(); ++k) {
@@ -83,16 +83,16 @@ std::string TumbleCsv() {
 }
 
 void BM_CalibrateTumble30Min(benchmark::State& state) {
-  jobspec::CalibrateSettings settings;
+  app::CalibrateSettings settings;
   settings.kind = "imu";
   settings.lat_deg = 45.0;  // TumbleSpec default latitude
   const bool from_csv = state.range(0) == 1;
   const std::string csv = from_csv ? TumbleCsv() : "";
-  const jobspec::NumericTable& table = TumbleTable();
+  const app::NumericTable& table = TumbleTable();
   int poses = 0;
   for (auto _ : state) {
     const v1::CalibrationResult result =
-        jobspec::RunCalibration(settings, from_csv ? jobspec::ReadNumericCsv(csv) : table);
+        app::RunCalibration(settings, from_csv ? app::ReadNumericCsv(csv) : table);
     poses = result.fits(0).poses_used();
     benchmark::DoNotOptimize(result.fits(1).residual_rms());
   }
@@ -102,10 +102,10 @@ void BM_CalibrateTumble30Min(benchmark::State& state) {
 BENCHMARK(BM_CalibrateTumble30Min)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 void BM_NoiseFitTenHours(benchmark::State& state) {
-  static const jobspec::NumericTable table = [] {
+  static const app::NumericTable table = [] {
     constexpr double kRateHz = 100.0;
     constexpr int64_t kSamples = 10 * 3600 * 100;
-    jobspec::NumericTable t;
+    app::NumericTable t;
     t.columns = {"omega_x_rad_per_s", "omega_y_rad_per_s", "omega_z_rad_per_s",
                  "f_x_m_per_s2",      "f_y_m_per_s2",      "f_z_m_per_s2"};
     t.values.resize(6 * static_cast<size_t>(kSamples));
@@ -120,11 +120,11 @@ void BM_NoiseFitTenHours(benchmark::State& state) {
     }
     return t;
   }();
-  jobspec::NoiseFitSettings settings;
+  app::NoiseFitSettings settings;
   settings.rate_hz = 100.0;
   double fit_time_s = 0.0;
   for (auto _ : state) {
-    const v1::NoiseModelFit fit = jobspec::RunNoiseFit(settings, table);
+    const v1::NoiseModelFit fit = app::RunNoiseFit(settings, table);
     fit_time_s = fit.fit_time_s();
     benchmark::DoNotOptimize(fit.terms_size());
   }

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Filter-consistency study of issue 18 on a result file of `driftlab run JOB --covariance`.
+"""Filter-consistency study on a result file of `driftlab run JOB --covariance`.
 
 Usage:
   bench/consistency_study.py RESULT.json [RESULT.json ...]

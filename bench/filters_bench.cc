@@ -1,7 +1,7 @@
-// Cost per IMU sample of the attitude and navigation filters (issue 7, "Measure"): the
-// complementary attitude filter, the 15-state covariance propagation (per propagation step and
-// per IMU sample at a given step), and the INS/GNSS error-state filter (mechanization +
-// covariance every 10 samples + a 6-D GNSS update every 100 samples).
+// Cost per IMU sample of the attitude and navigation filters: the complementary attitude filter,
+// the 15-state covariance propagation (per propagation step and per IMU sample at a given step),
+// and the INS/GNSS error-state filter (mechanization + covariance every 10 samples + a 6-D GNSS
+// update every 100 samples).
 // Build Release for numbers; items_per_second = IMU samples per second on one core.
 #include <benchmark/benchmark.h>
 
@@ -61,8 +61,8 @@ BENCHMARK(BM_ComplementaryFilter)
     ->Arg(static_cast<int>(ComplementaryPairKind::kButterworth4Seed));
 
 // The tactical preset: augmented = 0 reduced to the 15 core states (no flicker, scale factor,
-// misalignment: the model before issue 18), 1 the whole preset (87 states: flicker as 9
-// Gauss-Markov states per axis, scale factor and misalignment augmented).
+// misalignment), 1 the whole preset (87 states: flicker as 9 Gauss-Markov states per axis, scale
+// factor and misalignment augmented).
 ImuErrorModel TacticalModel(int64_t augmented) {
   ImuErrorModel model = FindImuPreset("tactical");
   if (augmented == 0) {

@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
 """Runs gnss-ins-sim and driftlab on the same motion file and IMU error model; prints both
-tools' error statistics at the final epoch and the speed ratio (issue 19).
+tools' error statistics at the final epoch and the speed ratio.
 
-gnss-ins-sim (github.com/Aceinna/gnss-ins-sim; run from a checkout, e.g. the one `fetch`ed for
-issue 19, on Debian's python3-numpy and python3-scipy) generates the trajectory from the motion
-file, adds the errors of its built-in IMU accuracy level and runs its free-integration demo
-algorithm (demo_algorithms/free_integration.py) in its virtual inertial frame (ref_frame=1: flat,
+gnss-ins-sim (github.com/Aceinna/gnss-ins-sim; run from a checkout, on Debian's python3-numpy
+and python3-scipy) generates the trajectory from the motion file, adds the errors of its built-in
+IMU accuracy level and runs its free-integration demo algorithm
+(demo_algorithms/free_integration.py) in its virtual inertial frame (ref_frame=1: flat,
 constant gravity, no Earth rotation). driftlab runs the same motion file (motion.gnss_ins_sim_file,
 earth_model FLAT) with the preset gnss-ins-sim-<level> (the same parameters, Gauss-Markov bias
 started at zero as gnss-ins-sim does) through its NED mechanization, initialised at the truth.

@@ -1,5 +1,5 @@
-// Lockstep free-inertial NED throughput per instruction-set path (issue 17): IMU samples per
-// second on one core for the scalar one-run-at-a-time reference (DRIFTLAB_ISA=scalar) and each
+// Lockstep free-inertial NED throughput per instruction-set path: IMU samples per second on one
+// core for the scalar one-run-at-a-time reference (DRIFTLAB_ISA=scalar) and each
 // lockstep path the CPU has (baseline, avx2, avx512), for three sensor models:
 //   * white noise only on all 6 axes;
 //   * white + Gauss-Markov + random walk on all 6 axes (no other term);
@@ -20,9 +20,9 @@
 #include <cstdlib>
 #include <string>
 
+#include "car_like_motion.h"
 #include "driftlab/monte_carlo.h"
 #include "driftlab/presets.h"
-#include "car_like_motion.h"
 
 namespace driftlab {
 namespace {
@@ -105,8 +105,8 @@ void BM_NedWhiteGaussMarkovRandomWalk(benchmark::State& state) {
 void BM_NedTactical(benchmark::State& state) { Run(state, FindImuPreset("tactical")); }
 
 // Thread scaling (strong: the same job on 1 and 2 threads, wall time): white + Gauss-Markov +
-// random walk, 256 runs, the widest path the CPU has. The shared truth (~50 ms here, one thread)
-// is the serial part: its share of the one-thread time bounds the speed-up (Amdahl).
+// random walk, 256 runs, the widest path the CPU has. The shared truth (one thread) is the
+// serial part: its share of the one-thread time bounds the speed-up (Amdahl).
 void BM_NedThreads(benchmark::State& state) {
   MonteCarloSpec spec = BenchJob(WhiteGaussMarkovRandomWalk());
   spec.runs = 256;

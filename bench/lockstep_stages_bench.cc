@@ -1,4 +1,4 @@
-// Stages of the lockstep free-inertial NED runs (issue 17), on one core, for one group of lanes
+// Stages of the lockstep free-inertial NED runs, on one core, for one group of lanes
 // of the widest path the CPU has (DRIFTLAB_ISA forces another), IMU samples x lanes per second:
 //   * deviates: LoadBlock alone (Philox + Box-Muller of every per-sample and flicker stream);
 //   * sensor errors: LoadBlock + the sensor-error step (kernel advance in the alignment mode,
@@ -24,7 +24,7 @@
 #include "driftlab/mc_statistics.h"
 #include "driftlab/presets.h"
 #include "driftlab/trajectory.h"
-#include "lockstep_ned.h"
+#include "lockstep/lockstep_ned.h"
 
 namespace driftlab {
 namespace {

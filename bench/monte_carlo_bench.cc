@@ -1,4 +1,4 @@
-// Monte-Carlo throughput (DESIGN.md "Speed by design", issue 4): IMU samples per second through
+// Monte-Carlo throughput (DESIGN.md "Speed by design"): IMU samples per second through
 // the full per-run pipeline (sensor error model "tactical" from presets.h with every term it has
 // on, mechanization A with coning/sculling, errors and exact sums at the epochs), at 1 and 2
 // worker threads. Build Release for numbers:
@@ -11,9 +11,9 @@
 
 #include <cmath>
 
+#include "car_like_motion.h"
 #include "driftlab/monte_carlo.h"
 #include "driftlab/presets.h"
-#include "car_like_motion.h"
 
 namespace driftlab {
 namespace {

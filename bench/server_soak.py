@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Soak test of driftlab-server on loopback with mixed valid and hostile requests (issue 15).
+"""Soak test of driftlab-server on loopback with mixed valid and hostile requests.
 
     PYTHONPATH=<build>/python:clients/python /usr/bin/python3 bench/server_soak.py \\
         --server-binary build/driftlab-server --minutes 30 [--clients 4] [--max-requests 200000]

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
-# CI's bounded fuzzing (issue 15; .ci/run's "fuzz" phase, budget 120 s): builds the libFuzzer
-# targets (fuzz/lib.sh) and runs each for DRIFTLAB_FUZZ_SECONDS (default 8; in CI what the build
-# left of the phase budget, 2 to 8) of wall time, as many at once as there are cores. Any crash, sanitizer report, leak, timeout or memory blow-up fails
-# the phase and names the input; add it to fuzz/regressions/<target>/ with the fix. Without
-# clang++-14 and libFuzzer's runtime the phase is skipped (exit 0) with a message saying so.
+# CI's bounded fuzzing (.ci/run's "fuzz" phase, budget 120 s): builds the libFuzzer targets
+# (fuzz/lib.sh) and runs each for DRIFTLAB_FUZZ_SECONDS (default 8; in CI what the build left of
+# the phase budget, 2 to 8) of wall time, as many at once as there are cores. Any crash, sanitizer
+# report, leak, timeout or memory blow-up fails the phase and names the input; add it to
+# fuzz/regressions/<target>/ with the fix. Without clang++-14 and libFuzzer's runtime the phase is
+# skipped (exit 0) with a message saying so.
 #
 # Longer runs on demand: fuzz/run.sh TARGET SECONDS.
 set -euo pipefail
@@ -23,9 +24,8 @@ echo "fuzz: built in $(($(date +%s) - start)) s"
 
 seconds="${DRIFTLAB_FUZZ_SECONDS:-8}"
 # Inside CI's phase budget (DRIFTLAB_FUZZ_PHASE_S, set by .ci/run) the fuzzing gets what the build
-# left: after a slow build (a partly cold compiler cache: 79 s measured with 32 of 102 objects to
-# compile, against ~10 s warm) each target runs shorter, down to 2 s, instead of the phase
-# overrunning. An explicit DRIFTLAB_FUZZ_SECONDS wins.
+# left: after a slow build (a partly cold compiler cache) each target runs shorter, down to 2 s,
+# instead of the phase overrunning. An explicit DRIFTLAB_FUZZ_SECONDS wins.
 if [ -n "${DRIFTLAB_FUZZ_PHASE_S:-}" ] && [ -z "${DRIFTLAB_FUZZ_SECONDS:-}" ]; then
   built=$(($(date +%s) - start))
   targets=$(fuzz_targets | wc -l)

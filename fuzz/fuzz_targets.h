@@ -1,4 +1,4 @@
-// The libFuzzer targets of issue 15 as plain functions: each takes one input (the bytes libFuzzer
+// The libFuzzer targets as plain functions: each takes one input (the bytes libFuzzer
 // generates, or a file of fuzz/corpus/ or fuzz/regressions/) and feeds it through one reader of
 // hostile input the way the CLI or the server does. A refusal (SpecError, LimitError) is the
 // expected answer to a bad input and is caught; anything else escaping (another exception, a

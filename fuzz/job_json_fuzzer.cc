@@ -1,5 +1,5 @@
 // Fuzz target: job files in JSON (fuzz_targets.h).
-#include "driftlab/jobspec/job_file.h"
+#include "driftlab/app/job_file.h"
 #include "driftlab/spec_error.h"
 #include "fuzz_support.h"
 #include "fuzz_targets.h"
@@ -10,7 +10,7 @@ namespace driftlab::fuzz {
 void FuzzJobJson(const uint8_t* data, size_t size) {
   v1::Job job;
   try {
-    job = jobspec::ParseJobJson(AsText(data, size), "fuzz.json");
+    job = app::ParseJobJson(AsText(data, size), "fuzz.json");
   } catch (const SpecError&) {
     return;
   }

@@ -1,21 +1,21 @@
 #include "job_validation.h"
 
-#include "driftlab/jobspec/job_file.h"
-#include "driftlab/jobspec/monte_carlo_job.h"
-#include "driftlab/jobspec/translate.h"
+#include "driftlab/app/job_file.h"
+#include "driftlab/app/monte_carlo_job.h"
+#include "driftlab/app/translate.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::fuzz {
 
 void ValidateParsedJob(const v1::Job& job) {
-  const jobspec::JobFile file{job, "/nonexistent/driftlab-fuzz"};
+  const app::JobFile file{job, "/nonexistent/driftlab-fuzz"};
   try {
-    jobspec::ValidateJob(file);
+    app::ValidateJob(file);
   } catch (const SpecError&) {
     return;
   }
   try {
-    jobspec::ToMonteCarloSpec(file, jobspec::MonteCarloOverrides{});
+    app::ToMonteCarloSpec(file, app::MonteCarloOverrides{});
   } catch (const SpecError&) {
   }
 }

@@ -1,5 +1,5 @@
 // Fuzz target: job files in YAML (fuzz_targets.h).
-#include "driftlab/jobspec/job_file.h"
+#include "driftlab/app/job_file.h"
 #include "driftlab/spec_error.h"
 #include "fuzz_support.h"
 #include "fuzz_targets.h"
@@ -10,7 +10,7 @@ namespace driftlab::fuzz {
 void FuzzJobYaml(const uint8_t* data, size_t size) {
   v1::Job job;
   try {
-    job = jobspec::ParseJobYaml(AsText(data, size), "fuzz.yaml");
+    job = app::ParseJobYaml(AsText(data, size), "fuzz.yaml");
   } catch (const SpecError&) {
     return;
   }

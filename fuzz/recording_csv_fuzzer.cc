@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "driftlab/jobspec/calibration_job.h"
+#include "driftlab/app/calibration_job.h"
 #include "driftlab/spec_error.h"
 #include "fuzz_support.h"
 #include "fuzz_targets.h"
@@ -14,21 +14,21 @@ namespace driftlab::fuzz {
 void FuzzRecordingCsv(const uint8_t* data, size_t size) {
   const std::string path = WriteScratchFile(data, size, ".csv");
   try {
-    jobspec::ReadNumericCsv(path, {"t_s", "omega_x_rad_per_s"}, "columns");
+    app::ReadNumericCsv(path, {"t_s", "omega_x_rad_per_s"}, "columns");
   } catch (const SpecError&) {
   }
-  jobspec::NumericTable table;
+  app::NumericTable table;
   try {
-    table = jobspec::ReadNumericCsv(path);
+    table = app::ReadNumericCsv(path);
   } catch (const SpecError&) {
     return;
   }
   try {
-    jobspec::SelectRateColumns(table, {}, "", 100.0, "fuzz");
+    app::SelectRateColumns(table, {}, "", 100.0, "fuzz");
   } catch (const SpecError&) {
   }
   try {
-    jobspec::SelectRateColumns(table, {}, "deg/h", 100.0, "fuzz");
+    app::SelectRateColumns(table, {}, "deg/h", 100.0, "fuzz");
   } catch (const SpecError&) {
   }
 }

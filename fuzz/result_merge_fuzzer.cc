@@ -5,10 +5,10 @@
 #include <optional>
 #include <string_view>
 
-#include "driftlab/jobspec/gate.h"
-#include "driftlab/jobspec/html_report.h"
-#include "driftlab/jobspec/monte_carlo_job.h"
-#include "driftlab/jobspec/result_file.h"
+#include "driftlab/app/gate.h"
+#include "driftlab/app/monte_carlo_job.h"
+#include "driftlab/app/result_file.h"
+#include "driftlab/report/html_report.h"
 #include "driftlab/spec_error.h"
 #include "fuzz_support.h"
 #include "fuzz_targets.h"
@@ -18,8 +18,8 @@ namespace {
 
 std::optional<v1::JobResult> ReadOne(std::string_view text, std::string_view source) {
   try {
-    v1::JobResult result = jobspec::ParseJobResultJson(text, source);
-    jobspec::RenderHtmlReport(result);
+    v1::JobResult result = app::ParseJobResultJson(text, source);
+    app::RenderHtmlReport(result);
     return result;
   } catch (const SpecError&) {
     return std::nullopt;
@@ -36,18 +36,17 @@ void FuzzResultMerge(const uint8_t* data, size_t size) {
   const std::optional<v1::JobResult> second = ReadOne(text.substr(nul + 1), "second.json");
   if (!first || !second) return;
   try {
-    jobspec::GateOptions options;
+    app::GateOptions options;
     options.allow_different_job = true;
-    const jobspec::GateReport report =
-        jobspec::RunGate(*first, *second, jobspec::DefaultGateRules(), options);
-    jobspec::FormatGateTable(report);
-    jobspec::RenderJunitXml(report);
+    const app::GateReport report = app::RunGate(*first, *second, app::DefaultGateRules(), options);
+    app::FormatGateTable(report);
+    app::RenderJunitXml(report);
   } catch (const SpecError&) {
   }
   try {
     const v1::JobResult merged =
-        jobspec::MergeJobResults({*first, *second}, {"first.json", "second.json"}, "fuzz");
-    jobspec::ValidateJobResult(merged);
+        app::MergeJobResults({*first, *second}, {"first.json", "second.json"}, "fuzz");
+    app::ValidateJobResult(merged);
   } catch (const SpecError&) {
   }
 }

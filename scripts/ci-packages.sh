@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Debian packages CI's tests need beyond bootstrap.sh: slurm-wlm and munge (tests/deploy/
 # slurm_test.py starts a one-node Slurm cluster), clang-14 and libclang-rt-14-dev (libFuzzer
-# targets, fuzz/ci.sh), chromium (tests/report/browser_test.py loads the HTML reports headless;
-# about 12 s to install on the development machine), g++-aarch64-linux-gnu and qemu-user-static
-# (tests/arm64/same_bits.sh builds the lane code for arm64 and runs it; about 9 s to install).
+# targets, fuzz/ci.sh), chromium (tests/report/browser_test.py loads the HTML reports
+# headless), g++-aarch64-linux-gnu and qemu-user-static (tests/arm64/same_bits.sh builds the lane
+# code for arm64 and runs it).
 # Non-interactive and idempotent, as bootstrap.sh.
 set -euo pipefail
 packages=(slurm-wlm munge clang-14 libclang-rt-14-dev chromium g++-aarch64-linux-gnu

@@ -4,8 +4,8 @@
 // With --fit (allan_fit.h): the Ceres noise-model fit, --out MODEL.json, --report REPORT.html.
 //
 // DATA.csv: one header row (names), then numeric rows; lines starting with '#' and empty lines are
-// skipped (jobspec::ReadNumericCsv; the column selection and units are
-// jobspec::SelectRateColumns, shared with the fit, calibration_job.h). Default columns: the point
+// skipped (app::ReadNumericCsv; the column selection and units are
+// app::SelectRateColumns, shared with the fit, calibration_job.h). Default columns: the point
 // samples of driftlab's imu.csv (omega_{x,y,z}_rad_per_s, f_{x,y,z}_m_per_s2; io.h ImuCsvWriter)
 // when all are present, else every column except a time column (t, t_*, time*). A column's unit
 // comes from --unit or from its name's suffix, words joined by '_' with "per" for '/':
@@ -34,7 +34,7 @@
 #include "allan_fit.h"
 #include "commands.h"
 #include "driftlab/allan.h"
-#include "driftlab/jobspec/calibration_job.h"
+#include "driftlab/app/calibration_job.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/units.h"
 
@@ -82,7 +82,7 @@ constexpr DisplayUnits kAccelDisplayMg{
     false,           "acceleration",  "m/s^2", "mg",  "m/s/sqrt(h)", "m/s/sqrt(s)",
     "m/s/h/sqrt(h)", "m/s^2/sqrt(s)", "mm/s",  "m/s", "mg/h",        "m/s^3"};
 
-using Column = jobspec::RateColumn;
+using Column = app::RateColumn;
 
 std::vector<std::string> SplitNames(const std::string& text) {
   std::vector<std::string> out;
@@ -97,8 +97,8 @@ std::vector<std::string> SplitNames(const std::string& text) {
 
 // Reads `path` (calibration_job.h ReadNumericCsv) and selects the columns as SI rates.
 std::vector<Column> ReadColumns(const AllanCliOptions& options) {
-  const jobspec::NumericTable table = jobspec::ReadNumericCsv(options.data_path);
-  return jobspec::SelectRateColumns(
+  const app::NumericTable table = app::ReadNumericCsv(options.data_path);
+  return app::SelectRateColumns(
       table, options.columns.empty() ? std::vector<std::string>{} : SplitNames(options.columns),
       options.unit, options.rate_hz, options.data_path, "--columns", "--unit");
 }

@@ -1,5 +1,5 @@
 // RunAllanFit (allan_fit.h): option parsing, printing and file writing around
-// jobspec::RunNoiseFit (calibration_job.h), the core `driftlab allan --fit` shares with the gRPC
+// app::RunNoiseFit (calibration_job.h), the core `driftlab allan --fit` shares with the gRPC
 // Calibration service.
 #include "allan_fit.h"
 
@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "commands.h"
-#include "driftlab/jobspec/calibration_job.h"
-#include "driftlab/jobspec/calibration_report.h"
+#include "driftlab/app/calibration_job.h"
+#include "driftlab/report/calibration_report.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/v1/job.pb.h"
 
@@ -44,7 +44,7 @@ int RunAllanFit(const AllanFitOptions& options) {
     if (options.points_per_octave < 1 || options.points_per_octave > 64) {
       throw SpecError("--points-per-octave", std::to_string(options.points_per_octave), "1 to 64");
     }
-    jobspec::NoiseFitSettings settings;
+    app::NoiseFitSettings settings;
     settings.rate_hz = options.rate_hz;
     settings.bias_model = options.bias_model;
     settings.points_per_octave = options.points_per_octave;
@@ -68,9 +68,9 @@ int RunAllanFit(const AllanFitOptions& options) {
                                                       "omega_z_rad_per_s", "f_x_m_per_s2",
                                                       "f_y_m_per_s2",      "f_z_m_per_s2"}
                            : SplitNames(options.columns);
-    const jobspec::NumericTable table = jobspec::ReadNumericCsv(
+    const app::NumericTable table = app::ReadNumericCsv(
         options.data_path, settings.columns, options.columns.empty() ? "DATA" : "--columns");
-    fit = jobspec::RunNoiseFit(settings, table);
+    fit = app::RunNoiseFit(settings, table);
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;
@@ -110,7 +110,7 @@ int RunAllanFit(const AllanFitOptions& options) {
     if (const int status = WriteOutputText(options.out_path, json, "--out")) return status;
   }
   if (options.report_path.empty()) return kExitOk;
-  return WriteOutputText(options.report_path, jobspec::RenderNoiseFitReport(fit, options.data_path),
+  return WriteOutputText(options.report_path, app::RenderNoiseFitReport(fit, options.data_path),
                          "--report");
 }
 

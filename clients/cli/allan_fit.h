@@ -1,6 +1,6 @@
-// Allan-deviation noise-model fit of a recording (issue 5, item 7: `driftlab allan DATA.csv --fit
-// --out MODEL.json [--report REPORT.html]`): reads the CSV columns (default: driftlab imu.csv
-// point samples omega_{x,y,z}_rad_per_s and f_{x,y,z}_m_per_s2) and runs jobspec::RunNoiseFit
+// Allan-deviation noise-model fit of a recording (`driftlab allan DATA.csv --fit --out MODEL.json
+// [--report REPORT.html]`): reads the CSV columns (default: driftlab imu.csv point samples
+// omega_{x,y,z}_rad_per_s and f_{x,y,z}_m_per_s2) and runs app::RunNoiseFit
 // (calibration_job.h: overlapping Allan deviation per column, IEEE Std 952 fit per axis and per
 // triad with calib/noise_fit.h); prints the fitted terms +- 1 sigma in datasheet units (next to a
 // datasheet's figures when one is given), writes the triad fits as a job-schema sensor fragment

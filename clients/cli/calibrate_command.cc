@@ -9,7 +9,7 @@
 // --rate is given); reference reads `in_x, in_y, in_z, out_x, out_y, out_z` rows (known input in
 // --input-unit, raw output in --output-unit) and fits each axis (or, with --matrix, the full
 // sensitivity matrix). The header row is optional; columns are taken by position. The fits are
-// jobspec::RunCalibration (calibration_job.h), the core the gRPC Calibration service shares.
+// app::RunCalibration (calibration_job.h), the core the gRPC Calibration service shares.
 #include <fmt/format.h>
 #include <google/protobuf/util/json_util.h>
 
@@ -19,8 +19,8 @@
 #include <string>
 
 #include "commands.h"
-#include "driftlab/jobspec/calibration_job.h"
-#include "driftlab/jobspec/calibration_report.h"
+#include "driftlab/app/calibration_job.h"
+#include "driftlab/report/calibration_report.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/v1/calibration.pb.h"
 #include "remote.h"
@@ -29,7 +29,7 @@ namespace driftlab::cli {
 namespace {
 
 struct CalibrateOptions {
-  jobspec::CalibrateSettings settings;
+  app::CalibrateSettings settings;
   std::string data_path;
   std::string out_path;
   std::string report_path;
@@ -49,12 +49,12 @@ void PrintFit(const v1::CalibrationFitResult& fit) {
 
 int RunCalibrate(CalibrateOptions o) {
   v1::CalibrationResult result;
-  jobspec::NumericTable table;
+  app::NumericTable table;
   try {
     o.settings.data_name = o.data_path;
-    table = jobspec::ReadNumericCsv(o.data_path);
+    table = app::ReadNumericCsv(o.data_path);
     if (o.remote.server.empty()) {
-      result = jobspec::RunCalibration(o.settings, table);
+      result = app::RunCalibration(o.settings, table);
     } else if (const int status = RemoteCalibrate(o.remote, o.settings, table, &result);
                status != kExitOk) {
       return status;
@@ -76,14 +76,13 @@ int RunCalibrate(CalibrateOptions o) {
   }
   if (const int status = WriteOutputText(o.out_path, json, "--out")) return status;
   if (o.report_path.empty()) return kExitOk;
-  return WriteOutputText(o.report_path,
-                         jobspec::RenderCalibrationReport(result, &table, o.settings.rate_hz),
-                         "--report");
+  return WriteOutputText(
+      o.report_path, app::RenderCalibrationReport(result, &table, o.settings.rate_hz), "--report");
 }
 
 const RegisterCommand kCalibrate("calibrate", [](CLI::App& app) -> std::function<int()> {
   auto o = std::make_shared<CalibrateOptions>();
-  jobspec::CalibrateSettings& s = o->settings;
+  app::CalibrateSettings& s = o->settings;
   CLI::App* c = app.add_subcommand(
       "calibrate",
       "Multi-position (accel|gyro|imu) or reference calibration; parameters +- 1 sigma");

@@ -11,10 +11,10 @@
 #include <string>
 
 #include "commands.h"
+#include "driftlab/app/job_file.h"
+#include "driftlab/app/sensor_model.h"
+#include "driftlab/app/sensor_model_json.h"
 #include "driftlab/calib/datasheet.h"
-#include "driftlab/jobspec/job_file.h"
-#include "driftlab/jobspec/sensor_model.h"
-#include "driftlab/jobspec/sensor_model_json.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::cli {
@@ -30,8 +30,8 @@ int RunDatasheet(const std::string& path, const std::string& out_path) {
       fmt::print("  {:<32} {:<24} {:<24} {}\n", v.key, v.text,
                  fmt::format("{:.6g} {}", v.value_si, v.si_unit), v.field);
     }
-    json = jobspec::SensorModelJson(d.model);
-    jobspec::ToImuErrorModel(jobspec::ParseJobJson(json, "datasheet model"));
+    json = app::SensorModelJson(d.model);
+    app::ToImuErrorModel(app::ParseJobJson(json, "datasheet model"));
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;

@@ -22,10 +22,10 @@
 #include <vector>
 
 #include "commands.h"
+#include "driftlab/app/job_file.h"
+#include "driftlab/app/sensor_model.h"
+#include "driftlab/app/translate.h"
 #include "driftlab/io.h"
-#include "driftlab/jobspec/job_file.h"
-#include "driftlab/jobspec/sensor_model.h"
-#include "driftlab/jobspec/translate.h"
 #include "driftlab/simulate.h"
 #include "driftlab/spec_error.h"
 #include "remote_client.h"
@@ -81,7 +81,7 @@ int RunRemoteExport(const ExportOptions& options) {
   std::unique_ptr<v1::Datasets::Stub> stub;
   try {
     v1::RunRef* run = request.mutable_run();
-    *run->mutable_job() = jobspec::LoadJobFile(options.job_path).job;
+    *run->mutable_job() = app::LoadJobFile(options.job_path).job;
     if (options.seed) run->set_seed(*options.seed);
     run->set_run_index(options.run_index);
     request.set_include_navigation(options.navigation);
@@ -90,7 +90,7 @@ int RunRemoteExport(const ExportOptions& options) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;
   }
-  const uint64_t seed = options.seed.value_or(jobspec::JobSeed(request.run().job()));
+  const uint64_t seed = options.seed.value_or(app::JobSeed(request.run().job()));
 
   grpc::ClientContext context;
   PrepareContext(options.remote, &context);
@@ -177,19 +177,19 @@ int RunRemoteExport(const ExportOptions& options) {
 
 int RunExport(const ExportOptions& options) {
   if (!options.remote.server.empty()) return RunRemoteExport(options);
-  jobspec::JobFile file;
+  app::JobFile file;
   SimulationSpec spec;
   std::optional<SensorRun> sensor;
   try {
-    file = jobspec::LoadJobFile(options.job_path);
-    spec = jobspec::ValidateJob(file);
-    std::optional<ImuErrorModel> model = jobspec::ToImuErrorModel(file.job);
+    file = app::LoadJobFile(options.job_path);
+    spec = app::ValidateJob(file);
+    std::optional<ImuErrorModel> model = app::ToImuErrorModel(file.job);
     if (!model) {
       throw SpecError("sensor", "(absent)",
                       "a sensor model (preset or parameters): export writes errored IMU data; "
                       "`driftlab simulate` writes the error-free data");
     }
-    sensor = SensorRun{*std::move(model), options.seed.value_or(jobspec::JobSeed(file.job)),
+    sensor = SensorRun{*std::move(model), options.seed.value_or(app::JobSeed(file.job)),
                        options.run_index};
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());

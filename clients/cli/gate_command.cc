@@ -19,8 +19,8 @@
 #include <vector>
 
 #include "commands.h"
-#include "driftlab/jobspec/gate.h"
-#include "driftlab/jobspec/result_file.h"
+#include "driftlab/app/gate.h"
+#include "driftlab/app/result_file.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::cli {
@@ -34,22 +34,21 @@ struct GateOptions {
   bool allow_different_job = false;
   bool list_metrics = false;
   bool strict = false;
-  double alpha = jobspec::kDefaultAlpha;
+  double alpha = app::kDefaultAlpha;
   double runs_for_change = 0;
 };
 
 // The rule deciding `name` (the last matching), or nullptr.
-const jobspec::GateRule* RuleFor(const std::vector<jobspec::GateRule>& rules,
-                                 const std::string& name) {
+const app::GateRule* RuleFor(const std::vector<app::GateRule>& rules, const std::string& name) {
   for (size_t r = rules.size(); r-- > 0;) {
-    if (jobspec::MetricMatches(rules[r].metric, name)) return &rules[r];
+    if (app::MetricMatches(rules[r].metric, name)) return &rules[r];
   }
   return nullptr;
 }
 
 // Planning: runs per file for a sigma change of `change` at the tolerance of the rule deciding
 // final.horizontal_position_m.std, over the metrics the rules gate in `result`.
-int PrintRunsForChange(const v1::JobResult& result, const std::vector<jobspec::GateRule>& rules,
+int PrintRunsForChange(const v1::JobResult& result, const std::vector<app::GateRule>& rules,
                        const GateOptions& options) {
   if (!(options.alpha > 0 && options.alpha < 1)) {
     throw SpecError("--alpha", fmt::format("{}", options.alpha), "0 < alpha < 1");
@@ -59,15 +58,15 @@ int PrintRunsForChange(const v1::JobResult& result, const std::vector<jobspec::G
                     "0 < change <= 100 (0.3 = sigma grown by 30 %)");
   }
   int gated = 0;
-  for (const jobspec::Metric& metric : jobspec::ListMetrics(result)) {
-    const jobspec::GateRule* rule = RuleFor(rules, metric.name);
+  for (const app::Metric& metric : app::ListMetrics(result)) {
+    const app::GateRule* rule = RuleFor(rules, metric.name);
     gated += rule && !rule->skip ? 1 : 0;
   }
   const std::string reference = "final.horizontal_position_m.std";
-  const jobspec::GateRule* rule = RuleFor(rules, reference);
-  const double rel_tol = rule && !rule->skip ? rule->rel_tol : jobspec::kDefaultRelTol;
-  const long runs = jobspec::RunsForSigmaChange(1.0 + options.runs_for_change, rel_tol,
-                                                options.alpha, std::max(gated, 1));
+  const app::GateRule* rule = RuleFor(rules, reference);
+  const double rel_tol = rule && !rule->skip ? rule->rel_tol : app::kDefaultRelTol;
+  const long runs = app::RunsForSigmaChange(1.0 + options.runs_for_change, rel_tol, options.alpha,
+                                            std::max(gated, 1));
   if (runs == 0) {
     fmt::print(
         "a sigma change of +{:g} % is within the {:g} % tolerance of {}: no run count "
@@ -85,38 +84,38 @@ int PrintRunsForChange(const v1::JobResult& result, const std::vector<jobspec::G
 }
 
 int RunGateCommand(const GateOptions& options) {
-  jobspec::GateReport report;
+  app::GateReport report;
   try {
-    const v1::JobResult current = jobspec::ReadJobResult(options.result_path);
+    const v1::JobResult current = app::ReadJobResult(options.result_path);
     if (options.list_metrics) {
-      for (const jobspec::Metric& metric : jobspec::ListMetrics(current)) {
+      for (const app::Metric& metric : app::ListMetrics(current)) {
         fmt::print("{} {}\n", metric.name, metric.value);
       }
       return kExitOk;
     }
-    const std::vector<jobspec::GateRule> rules = options.rules_path.empty()
-                                                     ? jobspec::DefaultGateRules()
-                                                     : jobspec::LoadGateRules(options.rules_path);
+    const std::vector<app::GateRule> rules = options.rules_path.empty()
+                                                 ? app::DefaultGateRules()
+                                                 : app::LoadGateRules(options.rules_path);
     if (options.runs_for_change != 0) return PrintRunsForChange(current, rules, options);
     if (options.baseline_path.empty()) {
       throw SpecError("--baseline", "", "a baseline result file (required unless --list-metrics)");
     }
-    const v1::JobResult baseline = jobspec::ReadJobResult(options.baseline_path);
-    jobspec::GateOptions gate_options;
+    const v1::JobResult baseline = app::ReadJobResult(options.baseline_path);
+    app::GateOptions gate_options;
     gate_options.alpha = options.alpha;
     gate_options.strict = options.strict;
     gate_options.allow_different_job = options.allow_different_job;
-    report = jobspec::RunGate(baseline, current, rules, gate_options);
+    report = app::RunGate(baseline, current, rules, gate_options);
     report.baseline_file = options.baseline_path;
     report.current_file = options.result_path;
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;
   }
-  fmt::print("{}", jobspec::FormatGateTable(report));
+  fmt::print("{}", app::FormatGateTable(report));
   if (!options.junit_path.empty()) {
     if (const int status =
-            WriteOutputText(options.junit_path, jobspec::RenderJunitXml(report), "--junit")) {
+            WriteOutputText(options.junit_path, app::RenderJunitXml(report), "--junit")) {
       return status;
     }
   }

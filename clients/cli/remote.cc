@@ -12,8 +12,8 @@
 #include <sstream>
 
 #include "commands.h"
+#include "driftlab/app/job_file.h"
 #include "driftlab/input_files.h"
-#include "driftlab/jobspec/job_file.h"
 #include "driftlab/spec_error.h"
 #include "interrupt.h"
 #include "remote_client.h"
@@ -260,7 +260,7 @@ int RunRemoteJob(const RemoteOptions& options, const RemoteRunRequest& run) {
   v1::SubmitJobRequest request;
   std::shared_ptr<grpc::Channel> channel;
   try {
-    *request.mutable_job() = jobspec::LoadJobFile(run.job_path).job;
+    *request.mutable_job() = app::LoadJobFile(run.job_path).job;
     if (run.covariance) request.mutable_job()->mutable_monte_carlo()->set_covariance(true);
     channel = MakeChannel(options);
   } catch (const SpecError& e) {
@@ -349,8 +349,8 @@ size_t RowsPerChunk(size_t columns) {
   return std::max<size_t>(1, doubles / std::max<size_t>(1, columns));
 }
 
-int RemoteCalibrate(const RemoteOptions& options, const jobspec::CalibrateSettings& settings,
-                    const jobspec::NumericTable& table, v1::CalibrationResult* result) {
+int RemoteCalibrate(const RemoteOptions& options, const app::CalibrateSettings& settings,
+                    const app::NumericTable& table, v1::CalibrationResult* result) {
   std::shared_ptr<grpc::Channel> channel;
   try {
     channel = MakeChannel(options);

@@ -17,7 +17,7 @@
 #include <optional>
 #include <string>
 
-#include "driftlab/jobspec/calibration_job.h"
+#include "driftlab/app/calibration_job.h"
 #include "driftlab/v1/calibration.pb.h"
 
 namespace driftlab::cli {
@@ -57,8 +57,8 @@ int RunRemoteJob(const RemoteOptions& options, const RemoteRunRequest& request);
 // most kMaxRowsMessageBytes) to Calibration.Calibrate and stores the reply in *result (the
 // command prints and writes it as for a local fit). Returns the exit status (kExitOk or the
 // status mapping above; the message is printed).
-int RemoteCalibrate(const RemoteOptions& options, const jobspec::CalibrateSettings& settings,
-                    const jobspec::NumericTable& table, v1::CalibrationResult* result);
+int RemoteCalibrate(const RemoteOptions& options, const app::CalibrateSettings& settings,
+                    const app::NumericTable& table, v1::CalibrationResult* result);
 
 // Largest payload of one streamed SampleRows message [bytes] (well under gRPC's default 4 MB
 // receive limit and the server's --max-message-bytes).

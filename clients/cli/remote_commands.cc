@@ -22,8 +22,8 @@
 #include <vector>
 
 #include "commands.h"
-#include "driftlab/jobspec/calibration_job.h"
-#include "driftlab/jobspec/job_file.h"
+#include "driftlab/app/calibration_job.h"
+#include "driftlab/app/job_file.h"
 #include "driftlab/spec_error.h"
 #include "remote_client.h"
 #include "run_output.h"
@@ -68,7 +68,7 @@ struct SubmitOptions {
 int RunSubmit(const SubmitOptions& options) {
   v1::SubmitJobRequest request;
   try {
-    *request.mutable_job() = jobspec::LoadJobFile(options.job_path).job;
+    *request.mutable_job() = app::LoadJobFile(options.job_path).job;
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;
@@ -211,14 +211,14 @@ struct ScoreOptions {
 
 int RunScore(const ScoreOptions& options) {
   v1::ScoreSolutionRequest header;
-  jobspec::NumericTable table;
+  app::NumericTable table;
   std::unique_ptr<v1::Datasets::Stub> stub;
   try {
     v1::RunRef* run = header.mutable_header()->mutable_run();
-    *run->mutable_job() = jobspec::LoadJobFile(options.job_path).job;
+    *run->mutable_job() = app::LoadJobFile(options.job_path).job;
     if (options.seed) run->set_seed(*options.seed);
     if (options.run_index) run->set_run_index(*options.run_index);
-    table = jobspec::ReadNumericCsv(options.solution_path);
+    table = app::ReadNumericCsv(options.solution_path);
     if (table.columns.empty() || table.rows() == 0) {
       throw SpecError(options.solution_path, "(empty)",
                       "a header row of column names and at least one row");

@@ -10,8 +10,8 @@
 #include <string>
 
 #include "commands.h"
-#include "driftlab/jobspec/html_report.h"
-#include "driftlab/jobspec/result_file.h"
+#include "driftlab/app/result_file.h"
+#include "driftlab/report/html_report.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::cli {
@@ -25,7 +25,7 @@ struct ReportOptions {
 int RunReport(const ReportOptions& options) {
   std::string html;
   try {
-    html = jobspec::RenderHtmlReport(jobspec::ReadJobResult(options.result_path));
+    html = app::RenderHtmlReport(app::ReadJobResult(options.result_path));
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;

@@ -26,13 +26,13 @@
 #include <vector>
 
 #include "commands.h"
-#include "driftlab/jobspec/consistency_check.h"
-#include "driftlab/jobspec/html_report.h"
-#include "driftlab/jobspec/job_file.h"
-#include "driftlab/jobspec/monte_carlo_job.h"
-#include "driftlab/jobspec/result_file.h"
+#include "driftlab/app/consistency_check.h"
+#include "driftlab/app/job_file.h"
+#include "driftlab/app/monte_carlo_job.h"
+#include "driftlab/app/result_file.h"
 #include "driftlab/monte_carlo.h"
 #include "driftlab/output_files.h"
+#include "driftlab/report/html_report.h"
 #include "driftlab/spec_error.h"
 #include "progress.h"
 #include "remote.h"
@@ -63,8 +63,8 @@ void PrintFinalSummary(const v1::JobResult& result) {
   fmt::print("{:<30}{:>12}{:>12}{:>26}{:>12}\n", "final error", "mean", "std", "std 95 % CI",
              "rms");
   for (const v1::ComponentStatistics& c : final_epoch.components()) {
-    const std::string name = fmt::format("{} [{}]", jobspec::ComponentKey(c.component()),
-                                         jobspec::ComponentUnit(c.component()));
+    const std::string name =
+        fmt::format("{} [{}]", app::ComponentKey(c.component()), app::ComponentUnit(c.component()));
     fmt::print("{:<30}{:>12.4e}{:>12.4e}  [{:>10.4e}, {:>10.4e}]{:>12.4e}\n", name, c.mean(),
                c.std(), c.std_ci95_low(), c.std_ci95_high(), c.rms());
   }
@@ -75,10 +75,10 @@ void PrintFinalSummary(const v1::JobResult& result) {
   const v1::Timings& t = result.timings();
   fmt::print("{} samples in {:.2f} s wall ({:.3g} samples/s, {} threads)\n", t.samples(),
              t.wall_s(), t.samples_per_s(), t.threads());
-  // Issue 18: say when the filter or the covariance analysis is wrong about its own uncertainty
+  // Say when the filter or the covariance analysis is wrong about its own uncertainty
   // (a shard holds too few runs to judge: only whole results are tested).
   if (result.run_count() == result.runs()) {
-    const jobspec::ConsistencyVerdict verdict = jobspec::AssessConsistency(result);
+    const app::ConsistencyVerdict verdict = app::AssessConsistency(result);
     if (verdict.tested()) {
       if (verdict.consistent()) {
         fmt::print("consistency: {}\n", verdict.Summary());
@@ -95,14 +95,14 @@ void WriteOutputs(const v1::JobResult& result, const std::string& out,
                   const std::optional<std::string>& report) {
   const std::filesystem::path out_path(out);
   if (out_path.has_parent_path()) std::filesystem::create_directories(out_path.parent_path());
-  jobspec::WriteJobResult(out_path, result);
+  app::WriteJobResult(out_path, result);
   fmt::print("wrote {}\n", out);
   if (report) {
     const std::filesystem::path report_path(*report);
     if (report_path.has_parent_path()) {
       std::filesystem::create_directories(report_path.parent_path());
     }
-    WriteOutputFile(report_path, jobspec::RenderHtmlReport(result), "--report");
+    WriteOutputFile(report_path, app::RenderHtmlReport(result), "--report");
     fmt::print("wrote {}\n", *report);
   }
 }
@@ -176,23 +176,23 @@ int RunRun(const RunOptions& options) {
                         {options.job_path, options.runs, options.seed, options.shard, options.out,
                          options.report, options.quiet, options.covariance});
   }
-  jobspec::JobFile file;
+  app::JobFile file;
   MonteCarloSpec spec;
   try {
-    file = jobspec::LoadJobFile(options.job_path);
-    jobspec::MonteCarloOverrides overrides;
+    file = app::LoadJobFile(options.job_path);
+    app::MonteCarloOverrides overrides;
     overrides.runs = options.runs;
     overrides.seed = options.seed;
     overrides.threads = options.threads;
     overrides.covariance = options.covariance;
     if (options.max_memory_gb)
       overrides.max_memory_bytes = MemoryLimitBytes(*options.max_memory_gb);
-    if (options.shard) jobspec::ParseShard(*options.shard, &overrides);
+    if (options.shard) app::ParseShard(*options.shard, &overrides);
     if (!OutputPathUsable(options.out, "--out") ||
         (options.report && !OutputPathUsable(*options.report, "--report"))) {
       return kExitBadJob;
     }
-    spec = jobspec::ToMonteCarloSpec(file, overrides);
+    spec = app::ToMonteCarloSpec(file, overrides);
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;
@@ -223,8 +223,7 @@ int RunRun(const RunOptions& options) {
   const double cpu_s = ProcessCpuSeconds() - cpu0_s;
   v1::JobResult result;
   try {
-    result =
-        jobspec::ToJobResult(jobspec::JobAsRun(file.job, spec), output, DRIFTLAB_VERSION, cpu_s);
+    result = app::ToJobResult(app::JobAsRun(file.job, spec), output, DRIFTLAB_VERSION, cpu_s);
   } catch (const std::exception& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitFailure;
@@ -242,8 +241,8 @@ int RunMerge(const MergeOptions& options) {
   std::vector<v1::JobResult> shards;
   v1::JobResult result;
   try {
-    for (const std::string& path : options.shards) shards.push_back(jobspec::ReadJobResult(path));
-    result = jobspec::MergeJobResults(shards, options.shards, DRIFTLAB_VERSION);
+    for (const std::string& path : options.shards) shards.push_back(app::ReadJobResult(path));
+    result = app::MergeJobResults(shards, options.shards, DRIFTLAB_VERSION);
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;

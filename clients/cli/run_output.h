@@ -14,7 +14,7 @@ namespace driftlab::cli {
 // mean/std/RMS with the std's 95 % interval, CEP50/CEP95/2DRMS, timings).
 void PrintFinalSummary(const v1::JobResult& result);
 
-// Writes the result file (jobspec::WriteJobResult) and, when given, the HTML report, creating
+// Writes the result file (app::WriteJobResult) and, when given, the HTML report, creating
 // their directories. Throws SpecError naming the file on a write error.
 void WriteOutputs(const v1::JobResult& result, const std::string& out,
                   const std::optional<std::string>& report);

@@ -12,10 +12,10 @@
 #include <system_error>
 
 #include "commands.h"
+#include "driftlab/app/job_file.h"
+#include "driftlab/app/sensor_model.h"
+#include "driftlab/app/translate.h"
 #include "driftlab/io.h"
-#include "driftlab/jobspec/job_file.h"
-#include "driftlab/jobspec/sensor_model.h"
-#include "driftlab/jobspec/translate.h"
 #include "driftlab/simulate.h"
 #include "driftlab/spec_error.h"
 
@@ -24,7 +24,7 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
 
-void PrintSummary(const jobspec::JobFile& file, const SimulationSpec& spec, const SensorRun* sensor,
+void PrintSummary(const app::JobFile& file, const SimulationSpec& spec, const SensorRun* sensor,
                   const SimulationSummary& summary, const std::filesystem::path& out_dir) {
   const std::string name = file.job.name().empty() ? "(unnamed)" : file.job.name();
   fmt::print("{}: {:.3f} s, {} steps at {:g} Hz, {} mechanization, {} earth\n", name,
@@ -65,14 +65,14 @@ struct SimulateOptions {
 
 int RunSimulate(const SimulateOptions& options) {
   const std::string& out_dir = options.out_dir;
-  jobspec::JobFile file;
+  app::JobFile file;
   SimulationSpec spec;
   std::optional<SensorRun> sensor;
   try {
-    file = jobspec::LoadJobFile(options.job_path);
-    spec = jobspec::ValidateJob(file);
-    if (std::optional<ImuErrorModel> model = jobspec::ToImuErrorModel(file.job)) {
-      sensor = SensorRun{*std::move(model), options.seed.value_or(jobspec::JobSeed(file.job)),
+    file = app::LoadJobFile(options.job_path);
+    spec = app::ValidateJob(file);
+    if (std::optional<ImuErrorModel> model = app::ToImuErrorModel(file.job)) {
+      sensor = SensorRun{*std::move(model), options.seed.value_or(app::JobSeed(file.job)),
                          options.run_index};
     }
   } catch (const SpecError& e) {

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "commands.h"
-#include "driftlab/jobspec/job_file.h"
-#include "driftlab/jobspec/monte_carlo_job.h"
+#include "driftlab/app/job_file.h"
+#include "driftlab/app/monte_carlo_job.h"
 #include "driftlab/output_files.h"
 #include "driftlab/slurm/shard_array.h"
 #include "driftlab/spec_error.h"
@@ -34,12 +34,12 @@ int RunOnSlurm(const SlurmRunOptions& options) {
   // The job is validated here, before anything is submitted: the tasks then only run it.
   fs::path work_dir;
   try {
-    const jobspec::JobFile file = jobspec::LoadJobFile(options.job_path);
-    jobspec::MonteCarloOverrides overrides;
+    const app::JobFile file = app::LoadJobFile(options.job_path);
+    app::MonteCarloOverrides overrides;
     overrides.runs = options.runs;
     overrides.seed = options.seed;
     overrides.covariance = options.covariance;
-    const MonteCarloSpec spec = jobspec::ToMonteCarloSpec(file, overrides);
+    const MonteCarloSpec spec = app::ToMonteCarloSpec(file, overrides);
     if (options.shards < 1 || options.shards > spec.runs || options.shards > 100000) {
       throw SpecError("--shards", std::to_string(options.shards),
                       fmt::format("1 .. the job's runs ({}), at most 100000", spec.runs));

@@ -6,8 +6,8 @@
 #include <string>
 
 #include "commands.h"
-#include "driftlab/jobspec/job_file.h"
-#include "driftlab/jobspec/monte_carlo_job.h"
+#include "driftlab/app/job_file.h"
+#include "driftlab/app/monte_carlo_job.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::cli {
@@ -15,8 +15,8 @@ namespace {
 
 int RunValidate(const std::string& job_path) {
   try {
-    const jobspec::JobFile file = jobspec::LoadJobFile(job_path);
-    jobspec::ToMonteCarloSpec(file, {});  // motion, navigation, sensor and monte_carlo
+    const app::JobFile file = app::LoadJobFile(job_path);
+    app::ToMonteCarloSpec(file, {});  // motion, navigation, sensor and monte_carlo
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;

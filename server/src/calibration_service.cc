@@ -1,6 +1,6 @@
 // Calibration service: multi-position / reference calibration and the Allan-deviation noise-model
 // fit of streamed samples, and datasheet conversion. The service only assembles the request into
-// the library's inputs (jobspec::NumericTable and settings, calibration_job.h; calib/datasheet.h)
+// the library's inputs (app::NumericTable and settings, calibration_job.h; calib/datasheet.h)
 // and maps errors to status codes; the fits are the ones `driftlab calibrate`, `driftlab allan
 // --fit` and `driftlab datasheet` run.
 //
@@ -19,9 +19,9 @@
 #include <utility>
 #include <vector>
 
+#include "driftlab/app/calibration_job.h"
+#include "driftlab/app/sensor_model_json.h"
 #include "driftlab/calib/datasheet.h"
-#include "driftlab/jobspec/calibration_job.h"
-#include "driftlab/jobspec/sensor_model_json.h"
 #include "driftlab/server/data_services.h"
 #include "driftlab/spec_error.h"
 
@@ -43,15 +43,15 @@ grpc::Status SettingsError(const SpecError& e, const google::protobuf::Descripto
 // The streamed table's column names: as many, as long and as distinct as a CSV header may be
 // (calibration_job.h: kMaxCsvColumns, kMaxCsvColumnNameBytes, no repeated name).
 void CheckColumnNames(const google::protobuf::RepeatedPtrField<std::string>& names) {
-  if (static_cast<size_t>(names.size()) > jobspec::kMaxCsvColumns) {
+  if (static_cast<size_t>(names.size()) > app::kMaxCsvColumns) {
     throw SpecError("settings.columns", fmt::format("{} columns", names.size()),
-                    fmt::format("at most {} columns", jobspec::kMaxCsvColumns));
+                    fmt::format("at most {} columns", app::kMaxCsvColumns));
   }
   for (int i = 0; i < names.size(); ++i) {
-    if (names[i].size() > jobspec::kMaxCsvColumnNameBytes) {
+    if (names[i].size() > app::kMaxCsvColumnNameBytes) {
       throw SpecError(fmt::format("settings.columns[{}]", i),
                       fmt::format("{} bytes", names[i].size()),
-                      fmt::format("at most {} bytes", jobspec::kMaxCsvColumnNameBytes));
+                      fmt::format("at most {} bytes", app::kMaxCsvColumnNameBytes));
     }
     for (int j = 0; j < i; ++j) {
       if (names[i] == names[j]) {
@@ -69,7 +69,7 @@ void CheckColumnNames(const google::protobuf::RepeatedPtrField<std::string>& nam
 template <typename Request, typename Settings>
 grpc::Status ReadStream(grpc::ServerReader<Request>* reader, const ServerLimits& limits,
                         size_t (*column_count)(const Settings&), Settings* settings,
-                        jobspec::NumericTable* table) {
+                        app::NumericTable* table) {
   Request request;
   bool have_settings = false;
   size_t columns = 0;
@@ -135,8 +135,8 @@ size_t NoiseFitColumns(const v1::NoiseFitSettings& s) {
   return static_cast<size_t>(s.columns_size());
 }
 
-jobspec::CalibrateSettings ToCalibrateSettings(const v1::CalibrateSettings& in) {
-  jobspec::CalibrateSettings out;
+app::CalibrateSettings ToCalibrateSettings(const v1::CalibrateSettings& in) {
+  app::CalibrateSettings out;
   out.kind = in.kind();
   if (in.has_rate_hz()) {
     if (!std::isfinite(in.rate_hz()) || in.rate_hz() <= 0.0) {
@@ -158,8 +158,8 @@ jobspec::CalibrateSettings ToCalibrateSettings(const v1::CalibrateSettings& in) 
   return out;
 }
 
-jobspec::NoiseFitSettings ToNoiseFitSettings(const v1::NoiseFitSettings& in) {
-  jobspec::NoiseFitSettings out;
+app::NoiseFitSettings ToNoiseFitSettings(const v1::NoiseFitSettings& in) {
+  app::NoiseFitSettings out;
   if (!std::isfinite(in.rate_hz()) || in.rate_hz() <= 0.0) {
     throw SpecError("settings.rate_hz", Num(in.rate_hz()), "a finite sample rate > 0 Hz");
   }
@@ -192,13 +192,13 @@ class CalibrationService final : public v1::Calibration::Service {
     std::string owner;
     if (grpc::Status s = auth_->Authenticate(*context, &owner); !s.ok()) return s;
     v1::CalibrateSettings settings;
-    jobspec::NumericTable table;
+    app::NumericTable table;
     try {
       const grpc::Status read = ReadStream(reader, limits_, &CalibrateColumns, &settings, &table);
       if (!read.ok()) return read;
       if (context->IsCancelled()) return grpc::Status::CANCELLED;
       table.columns.assign(settings.columns().begin(), settings.columns().end());
-      *response = jobspec::RunCalibration(ToCalibrateSettings(settings), table);
+      *response = app::RunCalibration(ToCalibrateSettings(settings), table);
     } catch (const SpecError& e) {
       return SettingsError(e, v1::CalibrateSettings::descriptor());
     }
@@ -211,13 +211,13 @@ class CalibrationService final : public v1::Calibration::Service {
     std::string owner;
     if (grpc::Status s = auth_->Authenticate(*context, &owner); !s.ok()) return s;
     v1::NoiseFitSettings settings;
-    jobspec::NumericTable table;
+    app::NumericTable table;
     try {
       const grpc::Status read = ReadStream(reader, limits_, &NoiseFitColumns, &settings, &table);
       if (!read.ok()) return read;
       if (context->IsCancelled()) return grpc::Status::CANCELLED;
       table.columns.assign(settings.columns().begin(), settings.columns().end());
-      *response = jobspec::RunNoiseFit(ToNoiseFitSettings(settings), table);
+      *response = app::RunNoiseFit(ToNoiseFitSettings(settings), table);
     } catch (const SpecError& e) {
       return SettingsError(e, v1::NoiseFitSettings::descriptor());
     }
@@ -232,7 +232,7 @@ class CalibrationService final : public v1::Calibration::Service {
     try {
       const calib::DatasheetModel d =
           calib::DatasheetToModel(calib::ParseDatasheetText(request->yaml(), "yaml"));
-      *response->mutable_sensor() = jobspec::ToSensorModelProto(d.model);
+      *response->mutable_sensor() = app::ToSensorModelProto(d.model);
       for (const calib::DatasheetValue& v : d.values) {
         v1::DatasheetFigure* figure = response->add_figures();
         figure->set_name(v.key);

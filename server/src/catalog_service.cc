@@ -10,7 +10,7 @@
 // datasheet units (sensor_model_json.h).
 //
 // Examples: every *.json / *.yaml / *.yml in the examples directory, parsed with the job loader
-// (jobspec::LoadJobFile) when the service is built; files that fail to parse and jobs that name
+// (app::LoadJobFile) when the service is built; files that fail to parse and jobs that name
 // motion files (the server reads no client-named files) are left out.
 #include <fmt/format.h>
 
@@ -21,8 +21,8 @@
 #include <string_view>
 #include <vector>
 
-#include "driftlab/jobspec/job_file.h"
-#include "driftlab/jobspec/sensor_model_json.h"
+#include "driftlab/app/job_file.h"
+#include "driftlab/app/sensor_model_json.h"
 #include "driftlab/presets.h"
 #include "driftlab/server/data_services.h"
 #include "driftlab/spec_error.h"
@@ -126,7 +126,7 @@ std::vector<v1::Example> LoadExamples(const std::filesystem::path& dir) {
   std::vector<v1::Example> examples;
   for (const std::filesystem::path& path : files) {
     try {
-      jobspec::JobFile file = jobspec::LoadJobFile(path);
+      app::JobFile file = app::LoadJobFile(path);
       if (ReferencesFiles(file.job)) continue;
       v1::Example& example = examples.emplace_back();
       example.set_name(path.stem().string());
@@ -167,7 +167,7 @@ class CatalogService final : public v1::Catalog::Service {
                                       fmt::join(names, ", ")));
     }
     FillSummary(*it, response->mutable_summary());
-    *response->mutable_sensor() = jobspec::ToSensorModelProto(*it);
+    *response->mutable_sensor() = app::ToSensorModelProto(*it);
     return grpc::Status::OK;
   }
 

@@ -2,7 +2,7 @@
 // engine's navigation solution), and an external solution scored against that run's truth.
 //
 // The run is the one a Monte-Carlo job with this seed gives run_index: the job is validated as
-// the CLI does (jobspec::ToMonteCarloSpec on JobFile{job, ""}, file references rejected: the
+// the CLI does (app::ToMonteCarloSpec on JobFile{job, ""}, file references rejected: the
 // server reads no client-named files) and replayed by the engine (ReplayMonteCarloRun: the same
 // truth, sensor errors, initial errors, alignment and mechanization as RunMonteCarlo). Rows are
 // laid out as dataset_rows.h documents (imu.csv / truth.csv columns of `driftlab export`).
@@ -19,8 +19,8 @@
 #include <utility>
 #include <vector>
 
-#include "driftlab/jobspec/dataset_rows.h"
-#include "driftlab/jobspec/monte_carlo_job.h"
+#include "driftlab/app/dataset_rows.h"
+#include "driftlab/app/monte_carlo_job.h"
 #include "driftlab/monte_carlo.h"
 #include "driftlab/server/data_services.h"
 #include "driftlab/spec_error.h"
@@ -61,10 +61,10 @@ ResolvedRun ResolveRun(const v1::RunRef& ref, const std::string& field, const Se
                     "no file reference: the server does not read files; inline the motion "
                     "(segments)");
   }
-  jobspec::MonteCarloOverrides overrides;
+  app::MonteCarloOverrides overrides;
   if (ref.has_seed()) overrides.seed = ref.seed();
   ResolvedRun out;
-  out.spec = jobspec::ToMonteCarloSpec(jobspec::JobFile{ref.job(), ""}, overrides);
+  out.spec = app::ToMonteCarloSpec(app::JobFile{ref.job(), ""}, overrides);
   out.run = ref.has_run_index() ? ref.run_index() : 0;
   if (out.run >= out.spec.runs) {
     throw SpecError(
@@ -73,7 +73,7 @@ ResolvedRun ResolveRun(const v1::RunRef& ref, const std::string& field, const Se
   }
   out.spec.first_run = out.run;
   out.spec.run_count = 1;
-  out.job_as_run = jobspec::JobAsRun(ref.job(), out.spec);
+  out.job_as_run = app::JobAsRun(ref.job(), out.spec);
   // Plans the segments only (ToMonteCarloSpec validated them); no samples are generated.
   out.samples =
       TrajectoryGenerator(out.spec.simulation.motion, out.spec.simulation.rate_hz).num_steps() + 1;
@@ -127,9 +127,9 @@ class DatasetsService final : public v1::Datasets::Service {
       grpc::Status limit = grpc::Status::OK;
       const ResolvedRun run = ResolveRun(request.header().run(), "header.run", limits_, &limit);
       if (!limit.ok()) return limit;
-      const jobspec::SolutionColumns columns(
+      const app::SolutionColumns columns(
           {request.header().columns().begin(), request.header().columns().end()}, "header.columns");
-      jobspec::RunScorer scorer(run.spec, run.run);
+      app::RunScorer scorer(run.spec, run.run);
       uint64_t message = 1, rows_message = 0, row = 0;
       while (reader->Read(&request)) {
         if (request.has_header()) {
@@ -156,7 +156,7 @@ class DatasetsService final : public v1::Datasets::Service {
         ++rows_message;
       }
       if (context->IsCancelled()) return grpc::Status(grpc::StatusCode::CANCELLED, "cancelled");
-      *response = jobspec::ToJobResult(run.job_as_run, scorer.Statistics("rows"), DRIFTLAB_VERSION);
+      *response = app::ToJobResult(run.job_as_run, scorer.Statistics("rows"), DRIFTLAB_VERSION);
     } catch (const SpecError& e) {
       return InvalidArgument(e);
     }
@@ -182,9 +182,9 @@ class DatasetsService final : public v1::Datasets::Service {
     };
     // Cancellation: checked at every chunk (at most kMaxRowsPerChunk samples of work).
     std::vector<double> imu, truth, nav;
-    imu.reserve(jobspec::kImuRowSize);
-    truth.reserve(jobspec::kTruthRowSize);
-    nav.reserve(jobspec::kNavigationRowSize);
+    imu.reserve(app::kImuRowSize);
+    truth.reserve(app::kTruthRowSize);
+    nav.reserve(app::kNavigationRowSize);
     try {
       ReplayMonteCarloRun(
           run.spec, run.run, navigation,
@@ -192,9 +192,9 @@ class DatasetsService final : public v1::Datasets::Service {
             v1::ExportRunResponse header_message;
             v1::ExportHeader* header = header_message.mutable_header();
             header->set_rate_hz(layout.rate_hz);
-            for (const std::string& c : jobspec::ImuColumns()) header->add_imu_columns(c);
-            for (const std::string& c : jobspec::TruthColumns()) header->add_truth_columns(c);
-            for (const std::string& c : jobspec::NavigationColumns()) {
+            for (const std::string& c : app::ImuColumns()) header->add_imu_columns(c);
+            for (const std::string& c : app::TruthColumns()) header->add_truth_columns(c);
+            for (const std::string& c : app::NavigationColumns()) {
               header->add_navigation_columns(c);
             }
             const auto rows = static_cast<uint64_t>(layout.num_steps + 1);
@@ -212,14 +212,14 @@ class DatasetsService final : public v1::Datasets::Service {
             const double t_s = step.truth->t_s;
             v1::ExportChunk* c = chunk.mutable_chunk();
             imu.clear();
-            jobspec::AppendImuRow(t_s, *step.measured_increment, *step.measured_sample, &imu);
+            app::AppendImuRow(t_s, *step.measured_increment, *step.measured_sample, &imu);
             c->mutable_imu()->Add(imu.begin(), imu.end());
             truth.clear();
-            jobspec::AppendTruthRow(*step.truth, &truth);
+            app::AppendTruthRow(*step.truth, &truth);
             c->mutable_truth()->Add(truth.begin(), truth.end());
             if (step.nav != nullptr) {
               nav.clear();
-              jobspec::AppendNavigationRow(t_s, *step.nav, &nav);
+              app::AppendNavigationRow(t_s, *step.nav, &nav);
               c->mutable_navigation()->Add(nav.begin(), nav.end());
             }
             if (++rows_in_chunk == rows_per_chunk) flush();

@@ -10,8 +10,8 @@
 #include <cmath>
 #include <limits>
 
-#include "driftlab/jobspec/job_file.h"
-#include "driftlab/jobspec/monte_carlo_job.h"
+#include "driftlab/app/job_file.h"
+#include "driftlab/app/monte_carlo_job.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/trajectory.h"
 
@@ -154,7 +154,7 @@ ValidatedJob ValidateSubmitRequest(const v1::SubmitJobRequest& request, int thre
                         "\": the server does not read files; inline the motion",
                     0);
   }
-  jobspec::MonteCarloOverrides overrides;
+  app::MonteCarloOverrides overrides;
   if (request.has_runs()) {
     if (request.runs() < 1 || request.runs() > kMaxMonteCarloRuns) {
       throw SpecError("runs", std::to_string(request.runs()),
@@ -165,7 +165,7 @@ ValidatedJob ValidateSubmitRequest(const v1::SubmitJobRequest& request, int thre
   if (request.has_seed()) overrides.seed = request.seed();
   if (!request.shard().empty()) {
     try {
-      jobspec::ParseShard(request.shard(), &overrides);
+      app::ParseShard(request.shard(), &overrides);
     } catch (const SpecError&) {
       throw SpecError("shard", "\"" + request.shard() + "\"", "i/K with 0 <= i < K, K >= 1");
     }
@@ -180,9 +180,9 @@ ValidatedJob ValidateSubmitRequest(const v1::SubmitJobRequest& request, int thre
   overrides.threads = threads_per_job;
   overrides.max_memory_bytes = max_memory_bytes;
 
-  jobspec::JobFile file{request.job(), std::filesystem::path()};
+  app::JobFile file{request.job(), std::filesystem::path()};
   ValidatedJob out;
-  out.spec = jobspec::ToMonteCarloSpec(file, overrides);
+  out.spec = app::ToMonteCarloSpec(file, overrides);
   const MonteCarloSpec& spec = out.spec;
   out.runs_total = spec.run_count == 0 ? spec.runs - spec.first_run : spec.run_count;
   // Samples per run as the engine counts them (monte_carlo.cc): the generator's output steps, plus
@@ -752,7 +752,7 @@ void JobManager::RunJob(const std::shared_ptr<LiveJob>& live) {
           live->reason == CancelReason::kDeadline ? "deadline exceeded" : "cancelled by its owner";
     } else {
       const v1::JobResult result =
-          jobspec::ToJobResult(jobspec::JobAsRun(request.job(), job.spec), output, version_);
+          app::ToJobResult(app::JobAsRun(request.job(), job.spec), output, version_);
       store_->StoreResult(id, SerializeDeterministic(result), UnixNow());
       final_state = v1::SUCCEEDED;
     }

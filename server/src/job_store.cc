@@ -139,7 +139,7 @@ JobStore::JobStore(const std::filesystem::path& data_dir) {
   Exec("PRAGMA journal_mode=WAL");
   Exec("PRAGMA synchronous=FULL");
   Exec(kSchema);
-  // Added with the cluster backends: a store written before them gets the column (empty).
+  // A store whose jobs table lacks the `cluster` column gets it (empty).
   bool has_cluster = false;
   {
     Statement s(db_, "SELECT name FROM pragma_table_info('jobs')");

@@ -27,7 +27,7 @@ std::string ReadPem(const std::filesystem::path& path, const std::string& option
 
 // gRPC's protobuf deserialization answers a request that is not a valid protobuf message with
 // INTERNAL and an empty message (grpcpp/impl/codegen/proto_utils.h: the message is
-// InitializationErrorString(), empty for proto3), before any service code runs (issue 15). That is
+// InitializationErrorString(), empty for proto3), before any service code runs. That is
 // bad input, not a server fault: this interceptor turns exactly that status (INTERNAL, empty
 // message; driftlab's own INTERNAL errors always carry a message) into INVALID_ARGUMENT naming the
 // method.

@@ -1,8 +1,8 @@
 // The engine's lane code on its own (no Eigen, no oneTBB), built for the machine and, by
 // tests/arm64/same_bits.sh, for arm64 (run under qemu-user): it prints digests of what the lane
-// code computes, and the script requires the two outputs to be equal line for line (issue 17:
-// "every path gives the same bits"; DESIGN.md "Same bits everywhere": the engine's own
-// elementary functions, lane-wise IEEE arithmetic, no contraction).
+// code computes, and the script requires the two outputs to be equal line for line (every path
+// gives the same bits; DESIGN.md "Same bits everywhere": the engine's own elementary functions,
+// lane-wise IEEE arithmetic, no contraction).
 // What it runs, at the baseline kernel's width (4 lanes: two SSE2 registers a value on x86-64,
 // two NEON registers on arm64):
 //   * lane_math::Log, SinCos, SinCosNear on a grid of arguments;
@@ -24,11 +24,11 @@
 #include <cstring>
 #include <memory>
 
-#include "lane_math.h"
-#include "lockstep_lanes.h"
-#include "lockstep_ned_kernel.h"
-#include "nav_error_lanes.h"
-#include "random_kernels.h"
+#include "lockstep/lockstep_lanes.h"
+#include "lockstep/lockstep_ned_kernel.h"
+#include "math/lane_math.h"
+#include "random/random_kernels.h"
+#include "stats/nav_error_lanes.h"
 
 namespace {
 

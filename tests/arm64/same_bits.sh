@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The engine on arm64 (issue 17: "the default build runs on any x86-64 and builds on arm64; every
-# path gives the same bits"), with Debian's cross compiler and qemu-user (scripts/ci-packages.sh
+# The engine on arm64 (the default build runs on any x86-64 and builds on arm64; every path gives
+# the same bits), with Debian's cross compiler and qemu-user (scripts/ci-packages.sh
 # installs g++-aarch64-linux-gnu and qemu-user-static; without them this exits 77, skipped):
 #  1. tests/arm64/lane_bits.cc (the lane code: lane_math, the deviates, the lockstep kernel's
 #     sensor and mechanization steps, the statistics' error components) built for this machine and

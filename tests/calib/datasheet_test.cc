@@ -96,8 +96,8 @@ TEST(DatasheetTest, BadInputsNameTheKeyTheValueAndTheAllowedUnits) {
                SpecError);  // tau missing
 }
 
-// yaml-cpp's LoadAll never returns on a ',' at a document's top level (yaml_document.h; found by
-// the datasheet fuzz target): such texts are refused, as is a second document.
+// yaml-cpp's LoadAll never returns on a ',' at a document's top level (yaml_document.h): such
+// texts are refused, as is a second document.
 TEST(DatasheetTest, StrayTopLevelCommaIsRefusedInsteadOfLoopingForever) {
   for (const std::string text : {",", "\n,", "# comment\n,", "name: x\n---\n,"}) {
     try {

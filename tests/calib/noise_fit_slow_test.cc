@@ -1,6 +1,6 @@
-// Noise-model fit on long simulated records of every grade preset (issue 5, "Noise fit": white
-// noise within 5 %, bias instability within 15 %, random walk within 25 %; model -> simulate ->
-// Allan round trip agrees). Slow: 3.6e6 samples per preset.
+// Noise-model fit on long simulated records of every grade preset (required: white noise within
+// 5 %, bias instability within 15 %, random walk within 25 %; model -> simulate -> Allan round
+// trip agrees). Slow: 3.6e6 samples per preset.
 //
 // Records (point samples, ImuErrorSimulator, static, seeded):
 //  * rate-grade, industrial, tactical: 10 h at 100 Hz. Their gyro white noise meets the flicker

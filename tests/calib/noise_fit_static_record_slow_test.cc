@@ -1,10 +1,10 @@
-// Issue 20, "Must show" (noise fit): 2-hour static recordings at 100 Hz made through the library
-// path `driftlab export` uses (RunSimulation with a SensorRun: the measured point samples that
-// export writes to imu.csv as omega_*_rad_per_s and f_*_m_per_s2), from the stim300, adis16470 and
-// tactical presets at 10 seeds fixed before the first run. The triad fit (three axes, one
-// parameter set: what `driftlab allan --fit` writes to the model) uses the model class the presets
-// are simulated with, the engine's band-limited flicker over the preset's band (CLI:
-// --bias-model flicker-band --flicker-tau-min 1 --flicker-tau-max 1000).
+// Noise fit of 2-hour static recordings at 100 Hz made through the library path `driftlab export`
+// uses (RunSimulation with a SensorRun: the measured point samples that export writes to imu.csv
+// as omega_*_rad_per_s and f_*_m_per_s2), from the stim300, adis16470 and tactical presets at 10
+// seeds fixed before the first run. The triad fit (three axes, one parameter set: what
+// `driftlab allan --fit` writes to the model) uses the model class the presets are simulated with,
+// the engine's band-limited flicker over the preset's band (CLI: --bias-model flicker-band
+// --flicker-tau-min 1 --flicker-tau-max 1000).
 //
 // Asserted per preset, triad and seed:
 //  * every term the preset has (white noise N, bias instability B) is kept by the selection test
@@ -17,9 +17,9 @@
 // the binomial(n, 0.05) 99.9 % quantile (n = 2 terms x 2 triads x seeds x presets).
 // Run time: the simulation dominates (7.2e5 steps per record); under DRIFTLAB_SANITIZE 3 seeds.
 //
-// Measured with the catalogue figures of issue 19 (stim300 = TS1524 rev. 31, adis16470 = Rev. C
-// Table 1 ARW/VRW; default confidence 0.999, generalised least squares; 54 s on one core for the
-// 30 records; --gtest_filter='*StaticRecord*'):
+// Measured with the catalogue figures (stim300 = TS1524 rev. 31, adis16470 = Rev. C Table 1
+// ARW/VRW; default confidence 0.999, generalised least squares; the 30 records,
+// --gtest_filter='*StaticRecord*'):
 //   preset / triad     N/preset mean  B/preset mean (range)   B not kept  spurious term kept
 //   stim300 gyro       1.0002         -- (floor invisible)    9 of 10     0 (max D 8.37)
 //                      (bound / preset 1.27-1.77, below the preset in 0 of 9; kept once, 1.44)
@@ -30,7 +30,8 @@
 //   tactical accel     1.0007         0.999 (0.996-1.003)     0           0 (max D 8.02)
 //   preset values outside their 95 % interval: 6 of 120 (expected 6, binomial 99.9 % bound 14).
 // The adis16470 accelerometer passes since its white noise is the datasheet's VRW 0.037
-// m/s/sqrt(h) (the earlier assumed 230 ug/sqrt(Hz) = 0.135 m/s/sqrt(h) hid the floor until ~700 s).
+// m/s/sqrt(h) (a white noise of 230 ug/sqrt(Hz) = 0.135 m/s/sqrt(h) would hide the floor until
+// ~700 s).
 // DISABLED_LateFloorTriadsBiasInstabilityRecovered keeps the known limit: the revision-9 STIM300
 // gyro (B 0.5 deg/h) meets its floor only at ~700 s (floor 0.664 B reached at
 // tau ~ (N / 0.664 B)^2), so a 2-hour record shows the floor in its last 2-3 octaves (edf 2-15),

@@ -146,7 +146,7 @@ TEST(NoiseFitTest, BandLimitedFlickerOfTheEngineRecovered) {
 
 // Simulated tactical gyro, 20 min at 100 Hz (short enough for the sanitizer build): the white
 // noise dominates up to ~20 s (N / sqrt(t) = 0.664 B at t = 20 s) with edf ~ 1e4-1e5 there, so N
-// is determined to < 1 %; 5 % is the criterion.
+// is determined to < 1 %; 5 % is the required accuracy.
 TEST(NoiseFitTest, ArwOfSimulatedTacticalGyroWithinFivePercent) {
   const ImuErrorModel& preset = FindImuPreset("tactical");
   const double rate_hz = 100.0;

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "../support/cli_runner.h"
+#include "support/cli_runner.h"
 
 namespace driftlab::testing {
 namespace {

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "../support/cli_runner.h"
+#include "support/cli_runner.h"
 
 namespace {
 
@@ -143,8 +143,8 @@ INSTANTIATE_TEST_SUITE_P(
       return name;
     });
 
-// Issue 15: these ran and wrote NaN (huge type-1 rate) or aliased output (a roll period far below
-// the 0.01 s sample interval); both are refused at validation with status 2.
+// Jobs that would write NaN (huge type-1 rate) or aliased output (a roll period far below the
+// 0.01 s sample interval) are refused at validation with status 2.
 TEST(Cli, HugeGnssInsSimRateAndAliasedShipPeriodAreRefusedWithStatus2) {
   Scratch scratch;
   const Result rate =

@@ -1,5 +1,5 @@
 // `driftlab export` and `driftlab simulate` with a sensor model: one seeded run's errored IMU data,
-// reproducible from (job, seed, run) alone (issue 3, items 5 and 6).
+// reproducible from (job, seed, run) alone.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "../support/cli_runner.h"
+#include "support/cli_runner.h"
 
 namespace {
 
@@ -40,8 +40,8 @@ std::vector<std::vector<double>> ReadCsv(const fs::path& path) {
 TEST(Export, WritesTheErroredDataOfOneSeededRun) {
   Scratch scratch;
   const fs::path job = kData / "static_gyro_white_noise.json";
-  const Result r = RunDriftlab({"export", job.string(), "--out", (scratch.dir() / "a").string()},
-                               scratch);
+  const Result r =
+      RunDriftlab({"export", job.string(), "--out", (scratch.dir() / "a").string()}, scratch);
   ASSERT_EQ(r.exit_status, 0) << r.err;
   for (const char* file : {"imu.csv", "imu_ideal.csv", "truth.csv", "truth_groves.csv"}) {
     EXPECT_TRUE(fs::exists(scratch.dir() / "a" / file)) << file;
@@ -112,9 +112,9 @@ TEST(Export, SimulateWritesTheSameMeasuredDataAsExport) {
 
 TEST(Export, AJobWithoutASensorModelIsRefused) {
   Scratch scratch;
-  const Result r = RunDriftlab(
-      {"export", (kExamples / "seed002_straight.json").string(), "--out", (scratch.dir() / "x").string()},
-      scratch);
+  const Result r = RunDriftlab({"export", (kExamples / "seed002_straight.json").string(), "--out",
+                                (scratch.dir() / "x").string()},
+                               scratch);
   EXPECT_EQ(r.exit_status, 2);
   EXPECT_NE(r.err.find("error: sensor: (absent) is not allowed"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(scratch.dir() / "x"));

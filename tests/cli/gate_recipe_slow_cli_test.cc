@@ -1,11 +1,11 @@
-// The README's CI recipe for `driftlab gate`, end to end with the `driftlab` binary (issue 16,
-// "Must show"): plan the run count with --runs-for-change, commit a baseline, rerun with another
-// seed (passes), degrade the IMU (fails with exit 1 and a JUnit file that a JUnit parser reads).
+// The README's CI recipe for `driftlab gate`, end to end with the `driftlab` binary: plan the run
+// count with --runs-for-change, commit a baseline, rerun with another seed (passes), degrade the
+// IMU (fails with exit 1 and a JUnit file that a JUnit parser reads).
 // Job: tests/cli/data/gate_arw_drive.json (gyro ARW only, 32 s). Seeds fixed before the first run:
 // baseline 1, rerun 2, degraded 3.
 //
 // Error rates of the two single checks, from the gate's guarantees: the rerun fails with
-// probability at most alpha = 5 % (measured 0 of 100 seed pairs in gate_slow_lib_test.cc); the
+// probability at most alpha = 5 % (measured 0 of 100 seed pairs in gate_slow_test.cc); the
 // degraded IMU (ARW x 1.3, +30 % sigma) is missed with probability at most 10 % at the planned run
 // count (measured 50 of 50 caught there).
 #include <gtest/gtest.h>
@@ -14,7 +14,7 @@
 #include <fstream>
 #include <string>
 
-#include "../support/cli_runner.h"
+#include "support/cli_runner.h"
 
 namespace driftlab::testing {
 namespace {

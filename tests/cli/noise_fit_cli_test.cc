@@ -8,7 +8,7 @@
 #include <regex>
 #include <string>
 
-#include "../support/cli_runner.h"
+#include "support/cli_runner.h"
 
 namespace driftlab::testing {
 namespace {
@@ -50,7 +50,7 @@ TEST(NoiseFitCliTest, DatasheetErrorsNameKeyValueAndAllowedUnits) {
 
 // White gyro noise of known density: N = sigma / sqrt(rate) (sensors.h point samples). 2^17
 // samples at 100 Hz: N comes from tau 0.01-100 s with edf ~ 1e5 at the short end, sigma(N) well
-// below 1 %; 5 % is the criterion.
+// below 1 %; 5 % is the required accuracy.
 TEST(NoiseFitCliTest, AllanFitRecoversWhiteNoiseAndWritesTheModel) {
   Scratch scratch;
   const auto csv = scratch.dir() / "imu.csv";

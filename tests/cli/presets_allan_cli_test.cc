@@ -1,4 +1,4 @@
-// `driftlab presets` and `driftlab allan` run as child processes (issue 3, items 4 and 5).
+// `driftlab presets` and `driftlab allan` run as child processes.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "../support/cli_runner.h"
+#include "support/cli_runner.h"
 
 namespace {
 
@@ -68,7 +68,7 @@ TEST(PresetsCli, TableListsEveryCatalogueNameExactlyOnce) {
   EXPECT_TRUE(Contains(bad.err, "sensor.preset")) << bad.err;
   EXPECT_TRUE(Contains(bad.err, "no-such-imu")) << bad.err;
   const std::vector<std::string> names = AllowedPresetNames(bad.err);
-  // Issue 3: 5 grades + 3 seed 002 + seed 000 + seed 003 + at least 8 current IMUs.
+  // Required: 5 grades + 3 seed 002 + seed 000 + seed 003 + at least 8 current IMUs.
   ASSERT_GE(names.size(), 18u) << bad.err;
 
   const Result table = RunDriftlab({"presets"}, scratch);

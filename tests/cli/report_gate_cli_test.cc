@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "../support/cli_runner.h"
-#include "../support/report_html.h"
+#include "support/cli_runner.h"
+#include "support/report_html.h"
 
 namespace driftlab::testing {
 namespace {
@@ -41,7 +41,7 @@ TEST(ReportCommand, WritesOneSelfContainedHtmlFileWithInteractivePlots) {
   const Result r = RunDriftlab({"report", kBaseline, "--out", out.string()}, scratch);
   ASSERT_EQ(r.exit_status, 0) << r.err;
   const std::string html = ReadFile(out);
-  // Nothing loaded from outside: the only scripts are the inline plotting library (issue 20).
+  // Nothing loaded from outside: the only scripts are the inline plotting library.
   const std::string markup = ::driftlab::testing::WithoutScriptText(html);
   EXPECT_EQ(markup.find("http://"), std::string::npos);
   EXPECT_EQ(markup.find("https://"), std::string::npos);

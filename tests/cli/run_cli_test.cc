@@ -1,6 +1,6 @@
-// `driftlab run`, `merge` and `gate` end to end, as a child process (issue 4): result and report
-// files, shards merged equal to one process, bad command lines and jobs, and the CI gate catching
-// a degraded sensor.
+// `driftlab run`, `merge` and `gate` end to end, as a child process: result and report files,
+// shards merged equal to one process, bad command lines and jobs, and the CI gate catching a
+// degraded sensor.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "../support/cli_runner.h"
-#include "../support/report_html.h"
+#include "support/cli_runner.h"
+#include "support/report_html.h"
 
 namespace {
 
@@ -61,7 +61,7 @@ TEST(Run, WritesAResultAndASelfContainedReport) {
 }
 
 TEST(Run, ConsistencyVerdictIsPrintedAndOnTheReportsFirstScreen) {
-  // Issue 18: with a covariance analysis (or a filter) the run says whether the Monte-Carlo
+  // With a covariance analysis (or a filter) the run says whether the Monte-Carlo
   // spread agrees with the prediction: one line, on stdout when consistent, as a warning on
   // stderr when not; the report shows the verdict before the summary table.
   Scratch scratch;
@@ -125,7 +125,7 @@ TEST(Run, FourShardsMergedEqualOneProcessAndThreadsDoNotMatter) {
   EXPECT_FALSE(fs::exists(file("bad.json")));
 }
 
-// Issue 17: the result file is the same to the byte on every instruction-set path of the
+// The result file is the same to the byte on every instruction-set path of the
 // lockstep runner (DRIFTLAB_ISA, inherited by the child process) and on the scalar reference.
 TEST(Run, EveryInstructionSetPathWritesTheSameResultFile) {
   Scratch scratch;

@@ -1,6 +1,6 @@
-"""A one-node Slurm cluster on 127.0.0.1 for the deploy tests (issue 21), started and stopped by
-the test: munged, slurmctld and slurmd (Debian's munge and slurm-wlm) configured in a temporary
-directory with free ports. Used by slurm_test.py (`driftlab run --slurm`) and
+"""A one-node Slurm cluster on 127.0.0.1 for the deploy tests, started and stopped by the test:
+munged, slurmctld and slurmd (Debian's munge and slurm-wlm) configured in a temporary directory
+with free ports. Used by slurm_test.py (`driftlab run --slurm`) and
 slurm_server_test.py (driftlab-server --cluster slurm).
 
     with SlurmCluster() as cluster:      # raises Skip without the packages or root

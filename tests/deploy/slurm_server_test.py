@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""driftlab-server --cluster slurm on a real one-node Slurm cluster started by this test (issue 21).
+"""driftlab-server --cluster slurm on a real one-node Slurm cluster started by this test.
 
     slurm_server_test.py SOURCE_DIR BUILD_DIR
 

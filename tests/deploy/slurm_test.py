@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""`driftlab run --slurm` on a real one-node Slurm cluster started by this test (issue 21).
+"""`driftlab run --slurm` on a real one-node Slurm cluster started by this test.
 
     slurm_test.py SOURCE_DIR BUILD_DIR
 

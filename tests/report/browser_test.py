@@ -1,6 +1,6 @@
 #!/usr/bin/python3
-"""Browser test of the HTML reports (issue 20): each report type, written by the CLI, loads in
-headless Chromium with no script error and every interactive plot drawn.
+"""Browser test of the HTML reports: each report type, written by the CLI, loads in headless
+Chromium with no script error and every interactive plot drawn.
 
 Usage: browser_test.py DRIFTLAB_CLI WORK_DIR [--screenshots DIR]
 (--screenshots: the first screen of each report, NAME.png, and one plot alone, NAME_plot.png.)

@@ -5,8 +5,7 @@
 # results do not depend on that choice. Each example job (8 runs) is run as this machine runs it
 # and with glibc told that the CPU has no AVX, AVX2, AVX-512 or FMA (GLIBC_TUNABLES: glibc then
 # takes its SSE2 variants, as on an older or a virtual CPU); the result files, but for their
-# timing fields, must be the same bytes. Before the engine had its own functions, 8 of these 9
-# examples differed (up to 16,903 lines of car_drive_gnss's result).
+# timing fields, must be the same bytes.
 # Exits 77 (skipped) where the tunable changes nothing (a CPU without FMA, or a glibc that
 # ignores it): there the comparison would show nothing.
 # Usage: glibc_variants.sh DRIFTLAB SOURCE_DIR WORK_DIR

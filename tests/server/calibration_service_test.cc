@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "driftlab/jobspec/calibration_job.h"
+#include "driftlab/app/calibration_job.h"
 #include "driftlab/random.h"
 #include "driftlab/server/data_services.h"
 #include "in_process_server.h"
@@ -89,13 +89,13 @@ TEST_F(CalibrationServiceTest, StreamedSeed003CalibrationEqualsTheLibraryCall) {
       &streamed);
   ASSERT_TRUE(status.ok()) << status.error_message();
 
-  jobspec::CalibrateSettings settings;
+  app::CalibrateSettings settings;
   settings.kind = "reference";
   settings.input_unit = "deg/s";
   settings.output_unit = "V";
   settings.data_name = "seed003";
-  const jobspec::NumericTable table{kReferenceColumns, kReferenceRows};
-  v1::CalibrationResult direct = jobspec::RunCalibration(settings, table);
+  const app::NumericTable table{kReferenceColumns, kReferenceRows};
+  v1::CalibrationResult direct = app::RunCalibration(settings, table);
   // Same inputs, same code path: identical bytes (NaN uncertainties included) but the fit times.
   for (auto* result : {&streamed, &direct}) {
     for (auto& fit : *result->mutable_fits()) fit.clear_fit_time_s();
@@ -141,10 +141,10 @@ TEST_F(CalibrationServiceTest, StreamedNoiseFitEqualsTheLibraryAndRecoversTheWhi
   const grpc::Status status = FitNoise(requests, &streamed);
   ASSERT_TRUE(status.ok()) << status.error_message();
 
-  jobspec::NoiseFitSettings settings;
+  app::NoiseFitSettings settings;
   settings.rate_hz = kRate_hz;
   settings.columns = {"omega_x_rad_per_s"};
-  v1::NoiseModelFit direct = jobspec::RunNoiseFit(settings, {{"omega_x_rad_per_s"}, values});
+  v1::NoiseModelFit direct = app::RunNoiseFit(settings, {{"omega_x_rad_per_s"}, values});
   streamed.clear_fit_time_s();
   direct.clear_fit_time_s();
   EXPECT_EQ(streamed.SerializeAsString(), direct.SerializeAsString());
@@ -203,7 +203,7 @@ TEST_F(CalibrationServiceTest, MalformedStreamsAreInvalidArgumentNamingTheField)
   negative_rate.set_rate_hz(-100.0);
   v1::CalibrateSettings unknown_kind = ReferenceSettings();
   unknown_kind.set_kind("magnetometer");
-  // Issue 15: unknown units, a unit of the wrong dimension and duplicate columns were accepted.
+  // Unknown units, a unit of the wrong dimension and duplicate columns are refused too.
   v1::CalibrateSettings unknown_unit = ReferenceSettings();
   unknown_unit.set_input_unit("furlong/fortnight");
   v1::CalibrateSettings wrong_dimension = ReferenceSettings();

@@ -6,8 +6,8 @@
 #include <cmath>
 #include <string>
 
-#include "driftlab/jobspec/monte_carlo_job.h"
-#include "driftlab/jobspec/sensor_model.h"
+#include "driftlab/app/monte_carlo_job.h"
+#include "driftlab/app/sensor_model.h"
 #include "driftlab/presets.h"
 #include "driftlab/server/data_services.h"
 #include "in_process_server.h"
@@ -76,7 +76,7 @@ TEST_F(CatalogServiceTest, GetPresetSensorModelTranslatesBackToTheCatalogueModel
     EXPECT_TRUE(preset.sensor().preset().empty()) << "the model must be explicit, not a preset";
     v1::Job job;
     *job.mutable_sensor() = preset.sensor();
-    const std::optional<ImuErrorModel> back = jobspec::ToImuErrorModel(job);
+    const std::optional<ImuErrorModel> back = app::ToImuErrorModel(job);
     ASSERT_TRUE(back.has_value()) << name;
     const ImuErrorModel& want = FindImuPreset(name);
     // Datasheet units and back through the units module: a few roundings of the SI factors
@@ -117,7 +117,7 @@ TEST_F(CatalogServiceTest, ListExamplesOffersRunnableJobsWithoutFileReferences) 
     EXPECT_FALSE(e.job().motion().has_gnss_ins_sim_file()) << e.name();
     EXPECT_FALSE(e.job().motion().has_truth_profile_file()) << e.name();
     // Runnable as sent: the server's validation (the CLI's) accepts it.
-    EXPECT_NO_THROW(jobspec::ToMonteCarloSpec(jobspec::JobFile{e.job(), ""}, {})) << e.name();
+    EXPECT_NO_THROW(app::ToMonteCarloSpec(app::JobFile{e.job(), ""}, {})) << e.name();
   }
   auto has = [&](const std::string& n) {
     return std::find(names.begin(), names.end(), n) != names.end();

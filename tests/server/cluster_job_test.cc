@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "cli_runner.h"
-#include "driftlab/jobspec/job_file.h"
+#include "driftlab/app/job_file.h"
 #include "driftlab/server/job_manager.h"
 #include "driftlab/server/job_store.h"
 #include "jobs_test_util.h"
@@ -16,7 +16,7 @@
 namespace driftlab::testing {
 namespace {
 
-// Polls Get until the job is final, at most 60 s (a bounded loop; the jobs here take < 1 s).
+// Polls Get until the job is final, at most 60 s (a bounded loop; the jobs here are small).
 v1::JobStatus WaitFinal(server::JobManager& manager, const std::string& id) {
   v1::JobStatus status;
   for (int i = 0; i < 6000; ++i) {
@@ -62,7 +62,7 @@ TEST(ClusterJobTest, FailedSubmissionFailsTheJobNamingSbatchAndWritesTheJobFile)
   ASSERT_TRUE(in) << job_file;
   std::stringstream text;
   text << in.rdbuf();
-  EXPECT_EQ(Deterministic(jobspec::ParseJobJson(text.str(), job_file.string())),
+  EXPECT_EQ(Deterministic(app::ParseJobJson(text.str(), job_file.string())),
             Deterministic(request.job()));
   EXPECT_EQ(store.Get(status.job_id())->cluster, "");  // nothing was submitted
   manager.Shutdown(std::chrono::milliseconds(0));

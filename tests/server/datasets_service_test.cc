@@ -15,11 +15,11 @@
 #include <string>
 #include <vector>
 
+#include "driftlab/app/job_file.h"
+#include "driftlab/app/monte_carlo_job.h"
+#include "driftlab/app/sensor_model.h"
+#include "driftlab/app/translate.h"
 #include "driftlab/io.h"
-#include "driftlab/jobspec/job_file.h"
-#include "driftlab/jobspec/monte_carlo_job.h"
-#include "driftlab/jobspec/sensor_model.h"
-#include "driftlab/jobspec/translate.h"
 #include "driftlab/monte_carlo.h"
 #include "driftlab/server/data_services.h"
 #include "in_process_server.h"
@@ -151,7 +151,7 @@ std::string Join(const google::protobuf::RepeatedPtrField<std::string>& names) {
 }
 
 TEST_F(DatasetsServiceTest, ExportedImuAndTruthRowsEqualTheDriftlabExportCsv) {
-  const v1::Job job = jobspec::ParseJobJson(kJobJson);
+  const v1::Job job = app::ParseJobJson(kJobJson);
   constexpr uint64_t kSeed = 9;
   constexpr uint32_t kRun = 2;
   Export got;
@@ -163,8 +163,8 @@ TEST_F(DatasetsServiceTest, ExportedImuAndTruthRowsEqualTheDriftlabExportCsv) {
       std::filesystem::temp_directory_path() / ("datasets_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   {
-    const SimulationSpec spec = jobspec::ValidateJob(jobspec::JobFile{job, ""});
-    const SensorRun sensor{*jobspec::ToImuErrorModel(job), kSeed, kRun};
+    const SimulationSpec spec = app::ValidateJob(app::JobFile{job, ""});
+    const SensorRun sensor{*app::ToImuErrorModel(job), kSeed, kRun};
     TruthCsvWriter truth(dir / "truth.csv");
     ImuCsvWriter imu(dir / "imu.csv");
     RunSimulation(spec, &sensor, [&](const SimulationStep& step) {
@@ -224,13 +224,13 @@ class DatasetsRoundTrip : public DatasetsServiceTest {
     ASSERT_TRUE(score_status.ok()) << score_status.error_message();
 
     // The in-process reference: `driftlab run --seed S` restricted to the shard [run, run + 1).
-    jobspec::MonteCarloOverrides overrides;
+    app::MonteCarloOverrides overrides;
     overrides.seed = seed;
-    MonteCarloSpec spec = jobspec::ToMonteCarloSpec(jobspec::JobFile{job, ""}, overrides);
+    MonteCarloSpec spec = app::ToMonteCarloSpec(app::JobFile{job, ""}, overrides);
     spec.first_run = run_index;
     spec.run_count = 1;
     const v1::JobResult reference =
-        jobspec::ToJobResult(jobspec::JobAsRun(job, spec), RunMonteCarlo(spec), DRIFTLAB_VERSION);
+        app::ToJobResult(app::JobAsRun(job, spec), RunMonteCarlo(spec), DRIFTLAB_VERSION);
 
     EXPECT_EQ(scored.job().SerializeAsString(), reference.job().SerializeAsString());
     EXPECT_EQ(scored.seed(), reference.seed());
@@ -240,9 +240,9 @@ class DatasetsRoundTrip : public DatasetsServiceTest {
     ASSERT_EQ(scored.epochs_size(), reference.epochs_size());
     ASSERT_EQ(scored.checkpoints_size(), reference.checkpoints_size());
 
-    const MonteCarloStatisticsData got = jobspec::StatisticsFromJobResult(scored, "scored").data();
+    const MonteCarloStatisticsData got = app::StatisticsFromJobResult(scored, "scored").data();
     const MonteCarloStatisticsData want =
-        jobspec::StatisticsFromJobResult(reference, "reference").data();
+        app::StatisticsFromJobResult(reference, "reference").data();
     EXPECT_EQ(got.epoch_times_s, want.epoch_times_s);
     EXPECT_EQ(got.runs, want.runs);
     // The navigation rows carry angles in degrees (the API's edge unit): rad -> deg -> rad changes
@@ -294,27 +294,27 @@ class DatasetsRoundTrip : public DatasetsServiceTest {
 };
 
 TEST_F(DatasetsRoundTrip, ScoreOfExportedNavigationReproducesMonteCarloRunWithInitialErrors) {
-  Check(jobspec::ParseJobJson(kJobJson), 9, 2);
+  Check(app::ParseJobJson(kJobJson), 9, 2);
 }
 
 TEST_F(DatasetsRoundTrip, ScoreReproducesStaticAlignmentRunOfTheExample) {
   // One hour at rest at 20 Hz; each run aligns over 5 min (levelling, gyrocompassing).
-  Check(jobspec::LoadJobFile(std::string(DRIFTLAB_SOURCE_DIR) +
-                             "/examples/static_alignment_navigation.yaml")
+  Check(app::LoadJobFile(std::string(DRIFTLAB_SOURCE_DIR) +
+                         "/examples/static_alignment_navigation.yaml")
             .job,
         1, 7);
 }
 
 TEST_F(DatasetsRoundTrip, ScoreReproducesSeed000MechanizationRun) {
   v1::Job job =
-      jobspec::LoadJobFile(std::string(DRIFTLAB_SOURCE_DIR) + "/examples/ship_seaway.json").job;
+      app::LoadJobFile(std::string(DRIFTLAB_SOURCE_DIR) + "/examples/ship_seaway.json").job;
   job.mutable_sensor()->set_preset("seed000-fog-imu");
   job.mutable_monte_carlo()->set_runs(3);
   Check(job, 5, 1);
 }
 
 TEST_F(DatasetsServiceTest, SolutionMissingAnEpochIsInvalidArgumentNamingTheTime) {
-  const v1::Job job = jobspec::ParseJobJson(kJobJson);
+  const v1::Job job = app::ParseJobJson(kJobJson);
   const v1::RunRef run = MakeRun(job, 9, 2);
   Export exported;
   ASSERT_TRUE(ExportRun(run, true, 0, &exported).ok());
@@ -335,7 +335,7 @@ TEST_F(DatasetsServiceTest, SolutionMissingAnEpochIsInvalidArgumentNamingTheTime
 }
 
 TEST_F(DatasetsServiceTest, MalformedRequestsAreInvalidArgumentNamingTheField) {
-  const v1::Job job = jobspec::ParseJobJson(kJobJson);
+  const v1::Job job = app::ParseJobJson(kJobJson);
   auto export_error = [&](const v1::RunRef& run, uint32_t rows_per_chunk) {
     Export out;
     return ExportRun(run, false, rows_per_chunk, &out);
@@ -391,7 +391,7 @@ TEST_F(DatasetsServiceTest, RunBeyondTheSampleLimitIsResourceExhausted) {
   InProcessServer server({service.get()});
   auto stub = v1::Datasets::NewStub(server.channel());
   v1::ExportRunRequest request;
-  *request.mutable_run() = MakeRun(jobspec::ParseJobJson(kJobJson), 9, 0);
+  *request.mutable_run() = MakeRun(app::ParseJobJson(kJobJson), 9, 0);
   grpc::ClientContext context;
   auto reader = stub->ExportRun(&context, request);
   v1::ExportRunResponse response;

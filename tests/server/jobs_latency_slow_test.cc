@@ -1,4 +1,4 @@
-// Measurements of driftlab-server on loopback (issue 6, "Measure"), printed, not timed: the
+// Measurements of driftlab-server on loopback, printed, not timed: the
 // submit-to-first-progress latency of small jobs (median, p99) and the server's overhead against
 // the in-process run of a 100-run job (label `slow`: measurements, not run under the sanitizers).
 // The assertions only check that every job succeeded and that the numbers are defined; the

@@ -111,8 +111,8 @@ TEST_F(JobsServiceTest, CancelReturnsWithin100msAndTheJobsCpuUseStops) {
   const double cancel_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
   EXPECT_EQ(cancelled.state(), v1::CANCELLED);
   EXPECT_EQ(cancelled.error(), "cancelled by its owner");
-  // Budget (issue 6): 100 ms. The engine polls the flag every 1024 samples (~0.1-1 ms of one
-  // thread), a loopback round trip is < 1 ms; the rest is scheduling on a shared machine.
+  // Budget: 100 ms. The engine polls the flag every 1024 samples (a small part of that) and a
+  // loopback round trip is shorter still; the rest is scheduling on a shared machine.
   EXPECT_LT(cancel_ms, 100.0);
 
   const double cpu1 = ProcessCpuSeconds(server_.pid());
@@ -137,8 +137,8 @@ TEST_F(JobsServiceTest, DeadlineCancelsTheJobWithDeadlineExceeded) {
   EXPECT_EQ(final_status.error(), "deadline exceeded");
   // Cancelled at the deadline: the deadline thread wakes at it and the engine stops within 1024
   // samples; 0.5 s margin for scheduling on a shared 2-core machine, 2 s in a sanitizer build
-  // (ASan + UBSan at -O0 run the job's start-up, validation and truth generation, which the
-  // engine does not poll, 5-20x slower; measured 0.89 s there with two tests in parallel).
+  // (ASan + UBSan at -O0 slow down the job's start-up, validation and truth generation, which the
+  // engine does not poll).
 #if defined(__SANITIZE_ADDRESS__)
   constexpr double kMargin_s = 2.0;
 #else
@@ -216,10 +216,10 @@ TEST_F(JobsServiceTest, HealthCheckAnswersServing) {
   EXPECT_EQ(bytes, std::string("\x08\x01", 2));
 }
 
-// Issue 15: bytes that are not a protobuf message were answered INTERNAL with an empty message
-// (gRPC's deserializer, before any driftlab code). Now INVALID_ARGUMENT naming the method; the
-// server then still answers the health check. 0xFF... is a tag with wire type 7, which does not
-// exist (protobuf encoding guide), so the bytes can never parse.
+// Bytes that are not a protobuf message (which gRPC's deserializer, before any driftlab code,
+// answers INTERNAL with an empty message) are INVALID_ARGUMENT naming the method; the server then
+// still answers the health check. 0xFF... is a tag with wire type 7, which does not exist
+// (protobuf encoding guide), so the bytes can never parse.
 TEST_F(JobsServiceTest, BytesThatAreNotAProtobufMessageAreInvalidArgument) {
   grpc::GenericStub stub(
       grpc::CreateChannel(server_.address(), grpc::InsecureChannelCredentials()));
@@ -341,10 +341,10 @@ TEST_F(JobsServiceTest, MalformedSubmitIsInvalidArgumentNamingTheField) {
     v1::JobStatus status;
     EXPECT_EQ(client_.Submit(request, &status).error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
   }
-  // Issue 15: a valid job whose memory (1 run x 100 000 s at 2000 Hz: 2e8 IMU increments of 48
-  // bytes, >= 9.6 GB) exceeds the server's --max-job-memory-gb (default 8 GB) is refused at
-  // Submit with RESOURCE_EXHAUSTED naming the limit, before anything is allocated; it used to be
-  // admitted (2e8 samples is under --max-job-samples) and end in std::bad_alloc.
+  // A valid job whose memory (1 run x 100 000 s at 2000 Hz: 2e8 IMU increments of 48 bytes,
+  // >= 9.6 GB) exceeds the server's --max-job-memory-gb (default 8 GB) is refused at Submit with
+  // RESOURCE_EXHAUSTED naming the limit, before anything is allocated (2e8 samples is under
+  // --max-job-samples: only the memory limit stops it).
   {
     v1::SubmitJobRequest request = Request(StaticJob(100000.0, 1, 7, 2000.0));
     request.mutable_job()->mutable_monte_carlo()->set_epoch_interval_s(10.0);  // 10 001 epochs

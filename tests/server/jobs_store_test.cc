@@ -59,7 +59,7 @@ TEST(JobStoreTest, StoredResultIsNeverOverwrittenOrDeleted) {
 TEST(JobStoreTest, ClusterHandleSurvivesRecoveryAndOldStoresGetTheColumn) {
   Scratch scratch;
   const fs::path db = scratch.dir() / "driftlab.db";
-  // A store written before the cluster backends: the jobs table without the `cluster` column.
+  // A store whose jobs table has no `cluster` column.
   ASSERT_EQ(
       ExecOnFile(db,
                  "CREATE TABLE jobs (seq INTEGER PRIMARY KEY AUTOINCREMENT, id TEXT NOT NULL "

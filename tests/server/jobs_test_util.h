@@ -15,8 +15,8 @@
 #include <string>
 #include <vector>
 
-#include "driftlab/jobspec/job_file.h"
-#include "driftlab/jobspec/monte_carlo_job.h"
+#include "driftlab/app/job_file.h"
+#include "driftlab/app/monte_carlo_job.h"
 #include "driftlab/monte_carlo.h"
 #include "driftlab/v1/service.grpc.pb.h"
 
@@ -35,7 +35,7 @@ inline v1::Job StaticJob(double duration_s, uint32_t runs, uint64_t seed = 7,
                            std::to_string(runs) + R"(, "seed": )" + std::to_string(seed) +
                            R"(, "initial_errors": {"position_ned_m": [1, 1, 2],
       "attitude_deg": [0.01, 0.01, 0.05]}, "epoch_interval_s": 1.0}})";
-  return jobspec::ParseJobJson(json, "StaticJob");
+  return app::ParseJobJson(json, "StaticJob");
 }
 
 // A job that runs for minutes (1e5 runs x 60 s x 100 Hz = 6e8 samples) but whose trajectory (the
@@ -68,15 +68,15 @@ inline std::string WithoutTimings(v1::JobResult result) {
 // What `driftlab run JOB [--runs] [--seed] [--shard]` computes in-process for this request
 // (clients/cli/run_command.cc): ToMonteCarloSpec, RunMonteCarlo, ToJobResult(JobAsRun(...)).
 inline v1::JobResult InProcessResult(const v1::SubmitJobRequest& request, int threads = 0) {
-  jobspec::MonteCarloOverrides overrides;
+  app::MonteCarloOverrides overrides;
   if (request.has_runs()) overrides.runs = request.runs();
   if (request.has_seed()) overrides.seed = request.seed();
-  if (!request.shard().empty()) jobspec::ParseShard(request.shard(), &overrides);
+  if (!request.shard().empty()) app::ParseShard(request.shard(), &overrides);
   overrides.threads = threads;
-  const jobspec::JobFile file{request.job(), {}};
-  const MonteCarloSpec spec = jobspec::ToMonteCarloSpec(file, overrides);
+  const app::JobFile file{request.job(), {}};
+  const MonteCarloSpec spec = app::ToMonteCarloSpec(file, overrides);
   const MonteCarloStatistics statistics = RunMonteCarlo(spec);
-  return jobspec::ToJobResult(jobspec::JobAsRun(file.job, spec), statistics, DRIFTLAB_VERSION);
+  return app::ToJobResult(app::JobAsRun(file.job, spec), statistics, DRIFTLAB_VERSION);
 }
 
 // A Jobs client with an optional bearer token.

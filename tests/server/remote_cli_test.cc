@@ -1,5 +1,5 @@
-// `driftlab --server ...` end to end (issue 6 item 4): the CLI as a child process against a
-// driftlab-server child process on 127.0.0.1 (ephemeral port, SQLite in a scratch directory).
+// `driftlab --server ...` end to end: the CLI as a child process against a driftlab-server child
+// process on 127.0.0.1 (ephemeral port, SQLite in a scratch directory).
 // A remote run writes the local run's result file byte for byte (but for the timings); submit,
 // status, watch, cancel, result and jobs round-trip; Ctrl-C during `run --server` cancels the
 // job; a wrong or missing token, an unreachable server and a bad job give the documented exit
@@ -24,7 +24,7 @@
 #include <vector>
 
 #include "cli_runner.h"
-#include "driftlab/jobspec/result_file.h"
+#include "driftlab/app/result_file.h"
 #include "server_runner.h"
 
 namespace {
@@ -433,8 +433,8 @@ TEST(RemoteExport, ImuAndTruthFilesEqualTheLocalExportAndScoreMatchesTheRun) {
       RunDriftlab({"run", kSmallJob.string(), "--runs", "1", "--out", one.string(), "-q"}, scratch)
           .exit_status,
       0);
-  const driftlab::v1::JobResult a = driftlab::jobspec::ReadJobResult(scored);
-  const driftlab::v1::JobResult b = driftlab::jobspec::ReadJobResult(one);
+  const driftlab::v1::JobResult a = driftlab::app::ReadJobResult(scored);
+  const driftlab::v1::JobResult b = driftlab::app::ReadJobResult(one);
   ASSERT_EQ(a.epochs_size(), b.epochs_size());
   for (int e = 0; e < a.epochs_size(); ++e) {
     ASSERT_EQ(a.epochs(e).t_s(), b.epochs(e).t_s());

@@ -17,8 +17,8 @@ TEST(ServerRestartTest, KillMinus9MidJobThenRestartKeepsResultsAndRerunsIdentica
   Scratch scratch;
   const fs::path data = scratch.dir() / "data";
   const v1::SubmitJobRequest small = Request(StaticJob(60.0, 4, 3));
-  // 40 runs x 300 s x 100 Hz = 1.2e6 samples: about a second on one thread, long enough to be
-  // killed after its first progress message.
+  // 40 runs x 300 s x 100 Hz = 1.2e6 samples: long enough to be killed after its first progress
+  // message.
   const v1::SubmitJobRequest medium = Request(StaticJob(300.0, 40, 5));
   std::string finished_id, interrupted_id, finished_bytes;
   {
@@ -66,7 +66,7 @@ TEST(ServerRestartTest, SigtermLetsARunningJobFinishWithinTheGracePeriod) {
   Scratch scratch;
   const fs::path data = scratch.dir() / "data";
   std::vector<std::string> args = kOneWorker;
-  // Grace long enough for the job at any build speed (a few s at -O2, ~30 s under ASan at -O0).
+  // Grace long enough for the job at any build speed (an ASan build at -O0 included).
   args.insert(args.end(), {"--shutdown-grace-s", "600"});
   ServerProcess server(data, args);
   ASSERT_TRUE(server.running()) << server.Log();

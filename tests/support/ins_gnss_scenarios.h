@@ -1,7 +1,7 @@
-// Shared scenarios of the INS/GNSS filter tests (tests/ins_gnss_filter_test.cc with a short
-// drive, tests/ins_gnss_filter_slow_test.cc with a longer one and more runs): one filter run with
-// the run's IMU, GNSS and initial errors, and the two Monte-Carlo checks (NEES consistency and the
-// outage). Header-only, namespace driftlab::testing.
+// Shared scenarios of the INS/GNSS filter tests (tests/engine/filters/ins_gnss_filter_test.cc with
+// a short drive, tests/engine/filters/ins_gnss_filter_slow_test.cc with a longer one and more
+// runs): one filter run with the run's IMU, GNSS and initial errors, and the two Monte-Carlo checks
+// (NEES consistency and the outage). Header-only, namespace driftlab::testing.
 #pragma once
 
 #include <gtest/gtest.h>

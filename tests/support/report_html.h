@@ -1,4 +1,4 @@
-// Helpers for the HTML-report tests (issue 20): the reports inline dygraphs and report_plots.js
+// Helpers for the HTML-report tests: the reports inline dygraphs and report_plots.js
 // in <script> elements, whose JavaScript text is not markup; the tests check the markup around it.
 #pragma once
 

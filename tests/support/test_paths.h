@@ -1,7 +1,7 @@
 // Where a test finds the source tree, ../shared and the binaries it drives. Force-included into
 // every test source (tests/CMakeLists.txt, driftlab_add_test_group), defined in test_paths.cc, the
 // one test file compiled with absolute paths: the test sources' own compile commands hold none, so
-// ccache reuses their objects across clones of the repository (issue 14).
+// ccache reuses their objects across clones of the repository.
 #pragma once
 
 namespace driftlab_test_paths {

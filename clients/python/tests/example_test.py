@@ -28,7 +28,7 @@ import grpc
 RUNS = 8
 
 # Two minutes at 20 Hz (2 400 samples per run): at rest, then a short drive with a turn; the
-# tactical preset. 8 runs take well under a second of CPU.
+# tactical preset. 8 runs keep the test short.
 SMALL_JOB = {
     "name": "python_client_small",
     "description": "Python client example test: 2 min at 20 Hz, tactical IMU.",

@@ -11,8 +11,8 @@
 #include <set>
 #include <sstream>
 
-#include "driftlab/jobspec/monte_carlo_job.h"
-#include "driftlab/jobspec/result_file.h"
+#include "driftlab/app/monte_carlo_job.h"
+#include "driftlab/app/result_file.h"
 #include "driftlab/output_files.h"
 #include "driftlab/spec_error.h"
 
@@ -247,9 +247,9 @@ v1::JobResult MergeShardResults(const fs::path& work_dir, uint32_t shards,
   std::vector<std::string> names;
   for (uint32_t i = 0; i < shards; ++i) {
     names.push_back((work_dir / fmt::format("shard-{}.json", i)).string());
-    results.push_back(jobspec::ReadJobResult(names.back()));
+    results.push_back(app::ReadJobResult(names.back()));
   }
-  return jobspec::MergeJobResults(results, names, engine_version);
+  return app::MergeJobResults(results, names, engine_version);
 }
 
 v1::JobResult ShardArray::Merge(const std::string& engine_version) const {

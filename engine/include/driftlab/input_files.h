@@ -1,4 +1,4 @@
-// Reading input files within limits (DESIGN.md invariant 10, issue 15): every reader checks, before
+// Reading input files within limits (DESIGN.md invariant 10): every reader checks, before
 // the work, that its input is a regular file (not a directory, a device such as /dev/zero, a FIFO)
 // of bounded size, and reads it line by line with a bounded line length, so no input file can make
 // a reader run forever or exhaust memory. Exceeding a limit is a SpecError naming the file, what

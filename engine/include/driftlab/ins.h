@@ -8,8 +8,8 @@
 //    rotations; gravity, Coriolis and the n-frame rotation are taken at the interval midpoint
 //    (extrapolated, then one predictor-corrector pass); position by the trapezoidal rule.
 //    Truncation: exact for rates and specific force linear in time; one-off O(dt^2) errors at
-//    steps of the angular rate (see tests/ins_slow_test.cc). Vertical channel free or aided by
-//    truth height.
+//    steps of the angular rate (see tests/engine/ins/ins_slow_test.cc). Vertical channel free or
+//    aided by truth height.
 // B: Seed000Mechanization — seed 000's algorithm exactly: navigation frame = body frame at start;
 //    gravity vector and gyro bias = means over an initial static period; first-order quaternion
 //    step Q(k+1) = (I + 1/2 Omega(omega_k) dt) Q(k) with the bias-corrected rate at the start of

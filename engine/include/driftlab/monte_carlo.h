@@ -118,13 +118,13 @@ struct MonteCarloSpec {
   std::vector<double> checkpoint_times_s;
   int threads = 0;  // worker threads; 0 = all hardware threads
 
-  // Navigation filter and aiding (issue 7). Random aiding errors come from RandomStream(seed, run,
+  // Navigation filter and aiding. Random aiding errors come from RandomStream(seed, run,
   // {SensorId::kGnss / kBarometer / kMagnetometer, ...}) (gnss.h, aiding.h), so results stay
   // bit-identical for any thread count and shard split.
   NavigationFilterKind filter = NavigationFilterKind::kNone;
   AidingSpec aiding;
   int64_t ekf_propagation_step_samples = 10;  // InsGnssFilterOptions::propagation_step_samples
-  // What the EKF and the covariance analysis assume (issue 18; error_state.h MakeErrorStateNoise;
+  // What the EKF and the covariance analysis assume (error_state.h MakeErrorStateNoise;
   // job fields navigation.ekf.sensor, .augment_scale_misalignment, .flicker_states_per_axis):
   //  * filter_sensor: the IMU model the filter assumes; absent = the truth model `sensor` (set it
   //    to study a mistuned filter: the consistency check then compares the filter's belief with
@@ -263,7 +263,7 @@ bool ReplayMonteCarloRun(const MonteCarloSpec& spec, uint32_t run, bool navigate
 // O(segments + epochs)): the Monte-Carlo fields, the sensor model, the navigation start, the
 // alignment window, the epochs and checkpoints against the trajectory, the aiding against the rate
 // and duration, and the memory estimate against spec.max_memory_bytes. `driftlab validate`,
-// `driftlab run` and the server's Submit call it (through jobspec::ToMonteCarloSpec), so a job
+// `driftlab run` and the server's Submit call it (through app::ToMonteCarloSpec), so a job
 // that validates runs. Throws SpecError.
 void ValidateMonteCarloSpec(const MonteCarloSpec& spec);
 

@@ -1,4 +1,4 @@
-// Writing output files safely (DESIGN.md invariant 10, issue 15): every file driftlab writes
+// Writing output files safely (DESIGN.md invariant 10): every file driftlab writes
 // (results, reports, CSV data, JUnit XML, models) goes to a temporary file in the target's
 // directory, is flushed to disk (fsync) and renamed over the target, so that a reader never sees
 // half a file and no partial file survives a failure; and a target that exists but is not a

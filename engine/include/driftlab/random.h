@@ -21,17 +21,16 @@
 // IEEE-754 correctly rounded and therefore identical everywhere. Consequence of 32-bit uniforms:
 // |z| <= sqrt(-2 ln 2^-32) = 6.66, i.e. the tails beyond 6.66 sigma (probability 2.7e-11) are
 // absent, and adjacent inputs give radii >= 3.2e-10 (relative) and angles 1.5e-9 rad apart. The
-// polynomials are summed only as far as that resolution needs (since issue 17; before, to ~1e-18):
-// each deviate is within 2.6e-11 |z| + 7.1e-12 r of the exact transform of its two words
-// (r = sqrt(-2 ln u1)), a twelfth of the input's own step; tests/random_test.cc checks it.
+// polynomials are summed only as far as that resolution needs: each deviate is within
+// 2.6e-11 |z| + 7.1e-12 r of the exact transform of its two words (r = sqrt(-2 ln u1)), a twelfth
+// of the input's own step; tests/engine/random/random_test.cc checks it.
 // Vectorisation: deviates are produced in chunks of 32 Philox blocks (SoA). The Box-Muller code
-// (engine/src/lane_math.h) has no branches, comparisons or conversion instructions, so GCC
-// vectorises it on every x86-64 level (baseline, AVX2, AVX-512: 5.3, 2.9, 1.7 ns per deviate
-// including Philox, measured with GCC 12 -O2); Philox runs 4 blocks per AVX2 vector with
-// VPMULUDQ where GCC leaves it scalar. The lockstep kernels draw the same deviates across the runs
-// of a group instead (random_kernels.h GaussianAcrossRuns: one vector lane per run, the same block
-// index; 0.93 ns a deviate on AVX-512). All operations are IEEE basic ones or integer: the same
-// bits on every path.
+// (engine/src/math/lane_math.h) has no branches, comparisons or conversion instructions, so GCC
+// vectorises it on every x86-64 level (baseline, AVX2, AVX-512); Philox runs 4 blocks per AVX2
+// vector with VPMULUDQ where GCC leaves it scalar. The lockstep kernels draw the same deviates
+// across the runs of a group instead (random_kernels.h GaussianAcrossRuns: one vector lane per
+// run, the same block index). All operations are IEEE basic ones or integer: the same bits on
+// every path.
 #pragma once
 
 #include <array>
@@ -45,12 +44,12 @@ namespace driftlab {
 inline constexpr int kPhiloxRounds = 10;
 
 // One Philox4x32-10 block: the 4 x 32-bit output for `counter` under `key`.
-// Known-answer vectors: Random123 kat_vectors (tests/random_test.cc).
+// Known-answer vectors: Random123 kat_vectors (tests/engine/random/random_test.cc).
 std::array<uint32_t, 4> Philox4x32(const std::array<uint32_t, 4>& counter,
                                    const std::array<uint32_t, 2>& key);
 
-// Which sensor a stream belongs to (aiding sensors reserve their numbers now so that adding them
-// later does not change the numbers of the inertial sensors).
+// Which sensor a stream belongs to. The numbers are fixed (kOdometer is reserved), so adding a
+// sensor does not change the numbers of the others.
 enum class SensorId : uint8_t {
   kGyro = 0,
   kAccel = 1,
@@ -71,9 +70,9 @@ enum class ErrorTerm : uint8_t {
   // white noise.
   kWhiteNoise = 0,
   kRandomWalk = 1,           // per sample: the walk's step
-  kRandomWalkIntegral = 2,   // not drawn since issue 17 (folded into kWhiteNoise); reserved
+  kRandomWalkIntegral = 2,   // not drawn (folded into kWhiteNoise); reserved
   kGaussMarkov = 3,          // per sample: the process' driving noise
-  kGaussMarkovIntegral = 4,  // not drawn since issue 17 (folded into kWhiteNoise); reserved
+  kGaussMarkovIntegral = 4,  // not drawn (folded into kWhiteNoise); reserved
   kFlicker = 5,              // per update of flicker component `component`
   kInitialState = 6,         // stationary initial states (component 0 = GM, 1 + j = flicker j)
   kTurnOnBias = 7,           // per run, index 0
@@ -108,7 +107,7 @@ class RandomStream {
   double Uniform(uint64_t index) const;
 
   // The Philox key and the counter's run and stream words (layout above), for kernels that
-  // produce a stream's deviates themselves (engine/src/random_kernels.h, the same code).
+  // produce a stream's deviates themselves (engine/src/random/random_kernels.h, the same code).
   const std::array<uint32_t, 2>& key() const { return key_; }
   uint32_t run_word() const { return run_word_; }
   uint32_t stream_word() const { return stream_word_; }
@@ -122,15 +121,16 @@ class RandomStream {
 // The engine's own elementary functions for the Gaussian transform (exposed for tests).
 // Natural logarithm of x in [2^-1022, 2^1024): exponent/mantissa split, then
 // ln m = 2 atanh(s), s = (m - 1)/(m + 1), Taylor series to s^11 (|s| <= 0.172: within 5.2e-11
-// relative; engine/src/lane_math.h says why that is enough for 32-bit uniforms).
+// relative; engine/src/math/lane_math.h says why that is enough for 32-bit uniforms).
 double PolyLog(double x);
 // sin(2 pi u) and cos(2 pi u) for u = x 2^-32 in [0, 1): reduced exactly (integer arithmetic) to
 // a quadrant and theta in [-pi/4, pi/4], Taylor series to theta^11 (sin) and theta^12 (cos)
 // (within 7.1e-12), then rotated by the quadrant.
 void PolySinCosTwoPi(uint32_t x, double* sin_out, double* cos_out);
 // sin x and cos x as the navigation code computes them (earth.cc, attitude.cc and the lockstep
-// kernels, engine/src/lane_math.h): n = round(2x/pi), t = x - n pi/2 by Cody-Waite with pi/2 in
-// three 33-bit pieces (exact for |x| < 1.6e6 rad), the same Taylor series on t, rotated by n mod 4.
+// kernels, engine/src/math/lane_math.h): n = round(2x/pi), t = x - n pi/2 by Cody-Waite with pi/2
+// in three 33-bit pieces (exact for |x| < 1.6e6 rad), the same Taylor series on t, rotated by n
+// mod 4.
 void PolySinCos(double x, double* sin_out, double* cos_out);
 
 }  // namespace driftlab

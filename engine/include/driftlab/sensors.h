@@ -230,8 +230,8 @@ class TriadErrorSimulator {
   std::vector<Channel> channels_;
 
   // The increment step is the lockstep kernel's at one lane (Kernel<1>::TriadStep in
-  // engine/src/lockstep_ned_kernel.h); these are its job constants (the lockstep runs' struct)
-  // and run state, with the field names of lockstep::TriadLanes (one double per lane).
+  // engine/src/lockstep/lockstep_ned_kernel.h); these are its job constants (the lockstep runs'
+  // struct) and run state, with the field names of lockstep::TriadLanes (one double per lane).
   struct StepState {
     double scale_misalignment[3][3] = {};  // [row][column]
     double constant_bias[3] = {};

@@ -2,7 +2,7 @@
 // allowed range (DESIGN.md invariant 7). Field paths use the proto field names of the job schema,
 // e.g. "motion.segments[2].turn.duration_s", so the CLI and the server report the same path.
 //
-// A message is always one line of bounded length, whatever the input (issue 15): the parts that
+// A message is always one line of bounded length, whatever the input: the parts that
 // echo input (field path, value, message) pass through MessageText, which escapes control bytes and
 // invalid UTF-8 as \xNN (a newline as \n) and cuts a long text, saying how long it was. So a
 // hostile value can neither inject lines into a log nor blow up a gRPC status past its metadata

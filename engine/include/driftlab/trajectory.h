@@ -195,7 +195,7 @@ struct MotionSpec {
   std::string field_path = "motion";
 };
 
-// Output-rate limits of the generator (issue 2: 1-2000 Hz, durations up to 100,000 s).
+// Output-rate limits of the generator (1-2000 Hz, durations up to 100,000 s).
 inline constexpr double kMinRate_hz = 1.0;
 inline constexpr double kMaxRate_hz = 2000.0;
 inline constexpr double kMaxDuration_s = 100000.0;
@@ -244,9 +244,8 @@ class TrajectoryGenerator {
   // Advances one output step; false when the trajectory has ended.
   bool Next(TrajectorySample* out);
   // Whether Next computes the point sample (TrajectorySample::sample; default true). A caller that
-  // only uses the increments and the truth (the free-inertial NED runs) turns it off: the point
-  // sample is about a sixth of the generator's work, and Next then leaves out->sample as it is.
-  // Nothing else changes.
+  // only uses the increments and the truth (the free-inertial NED runs) turns it off to save the
+  // generator that work; Next then leaves out->sample as it is. Nothing else changes.
   void set_point_samples(bool on);
   // Steps produced so far.
   int64_t step() const;

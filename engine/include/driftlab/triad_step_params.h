@@ -1,5 +1,5 @@
 // Job constants of one sensor triad's error step, flattened for the lane kernel
-// (engine/src/lockstep_ned_kernel.h, TriadStep): the lockstep runs hold one per triad, and
+// (engine/src/lockstep/lockstep_ned_kernel.h, TriadStep): the lockstep runs hold one per triad, and
 // TriadErrorSimulator runs the same step at one lane with the same struct. Plain data with no
 // library types, so the per-instruction-set kernel files can include it (engine/src/
 // lockstep_lanes.h explains why they must not share inline code). Filled by TriadStepParamsOf

@@ -30,8 +30,9 @@
 
 namespace driftlab {
 
-// Limits of a unit text (issue 15: hostile input is bounded before the work): its length and the
-// nesting of parentheses and square roots. Real units ("((deg/h)/sqrt(Hz))") use 2 or 3 levels.
+// Limits of a unit text (hostile input is bounded before the work; DESIGN.md invariant 10): its
+// length and the nesting of parentheses and square roots. Real units ("((deg/h)/sqrt(Hz))") use 2
+// or 3 levels.
 inline constexpr size_t kMaxUnitTextBytes = 128;
 inline constexpr int kMaxUnitNesting = 8;
 

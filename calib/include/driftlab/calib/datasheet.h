@@ -1,7 +1,7 @@
-// Datasheet -> error model (issue 5, item 5): a datasheet summary file holds the figures of an
-// IMU's datasheet with their units as printed ("0.15 deg/√h", "25 µg/√Hz", "±450 deg/s"); this
-// module converts them through the units module (units.h) into an ImuErrorModel (SI,
-// sensor_params.h) with the mapping of presets.h, and lists every derived SI value.
+// Datasheet -> error model: a datasheet summary file holds the figures of an IMU's datasheet with
+// their units as printed ("0.15 deg/√h", "25 µg/√Hz", "±450 deg/s"); this module converts them
+// through the units module (units.h) into an ImuErrorModel (SI, sensor_params.h) with the mapping
+// of presets.h, and lists every derived SI value.
 //
 // File format: YAML (any form: block or flow mappings, multi-line flow mappings, comments, quotes),
 // one document, a mapping of name, description, gyro, accel; gyro and accel map keys to scalars:

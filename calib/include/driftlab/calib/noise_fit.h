@@ -1,7 +1,7 @@
-// Noise-model fit of Allan-deviation curves (issue 5, item 4): a weighted least-squares fit, with
-// Ceres, of the IEEE Std 952-1997 Annex C noise terms to one or more overlapping Allan-deviation
-// curves of a sensor (allan.h), giving each term with its 1-sigma uncertainty and a triad error
-// model (sensor_params.h) that the engine can simulate.
+// Noise-model fit of Allan-deviation curves: a weighted least-squares fit, with Ceres, of the
+// IEEE Std 952-1997 Annex C noise terms to one or more overlapping Allan-deviation curves of a
+// sensor (allan.h), giving each term with its 1-sigma uncertainty and a triad error model
+// (sensor_params.h) that the engine can simulate.
 //
 // Model (Allan variance [u^2] at averaging time t [s]; u = rad/s for a gyro, m/s^2 for an
 // accelerometer; IEEE Std 952-1997 Annex C, table C.2):

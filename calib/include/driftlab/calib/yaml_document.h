@@ -3,9 +3,9 @@
 // yaml-cpp 0.7's YAML::LoadAll never returns on some short texts: a ',' at the top level of a
 // document (outside [ ] and { }) is never consumed, and every further call of
 // Parser::HandleNextDocument yields another empty document, so LoadAll loops, its vector of
-// documents growing until memory runs out (found by the datasheet and job_yaml fuzz targets,
-// issue 15; input "," alone). driftlab accepts one document per text, so it never needs more than
-// two: this reader counts documents up to two and loads only the first.
+// documents growing until memory runs out (input "," alone does it). driftlab accepts one document
+// per text, so it never needs more than two: this reader counts documents up to two and loads only
+// the first.
 #pragma once
 
 #include <yaml-cpp/yaml.h>

@@ -2,8 +2,8 @@
 // run Monte-Carlo jobs, cancellation, deadlines, progress for Watch, and graceful shutdown.
 //
 // A job runs exactly as `driftlab run` runs it (clients/cli/run_command.cc): the request's job
-// becomes a jobspec::JobFile with no base directory, jobspec::ToMonteCarloSpec validates and
-// translates it with the request's overrides, RunMonteCarlo runs it, and jobspec::ToJobResult
+// becomes a app::JobFile with no base directory, app::ToMonteCarloSpec validates and
+// translates it with the request's overrides, RunMonteCarlo runs it, and app::ToJobResult
 // turns the statistics into the stored driftlab.v1.JobResult. The engine's statistics are exact
 // sums whatever the thread count (monte_carlo.h), so the server's result equals the in-process one
 // bit for bit apart from the timings, and a job re-run after a crash gives the same result.

@@ -1,7 +1,8 @@
 // What every driftlab gRPC service implementation shares (server/): authentication of a call,
 // the server's limits, and the mapping of validation errors to gRPC status codes.
 //
-// Services never compute physics (DESIGN.md): they translate protobuf <-> engine/jobspec calls.
+// Services never compute physics (DESIGN.md): they translate protobuf <-> engine and
+// application-layer calls (clients/app).
 #pragma once
 
 #include <grpcpp/grpcpp.h>

@@ -1,0 +1,151 @@
+// The engine's one run loop (engine/src/montecarlo/run_loop.h) seen through its three callers:
+// RunMonteCarlo, ReplayMonteCarloRun and RunSimulation run the same samples through the same
+// navigators, so a replayed run scores to RunMonteCarlo's numbers for that run and the simulation
+// of a run equals its replay bit for bit; cancellation stops a replay at the first poll (every 1024
+// samples).
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <bit>
+#include <cstdint>
+#include <vector>
+
+#include "driftlab/mc_statistics.h"
+#include "driftlab/monte_carlo.h"
+#include "driftlab/presets.h"
+#include "driftlab/simulate.h"
+#include "support/small_monte_carlo_job.h"
+
+namespace driftlab {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+// testing::SmallMonteCarloJob with 4 runs, seed 7 and checkpoints at 25 s, 40 s and the end.
+MonteCarloSpec SmallJob() {
+  MonteCarloSpec spec = testing::SmallMonteCarloJob();
+  spec.runs = 4;
+  spec.seed = 7;
+  spec.checkpoint_times_s = {25.0, 40.0};
+  return spec;
+}
+
+// Each run replayed with navigation, its solution scored against the truth at the checkpoints
+// (ComputeNavError, ErrorComponentsOf: what RunMonteCarlo stores), equals RunMonteCarlo's
+// checkpoint values of that run to the bit.
+void ExpectReplayScoresAsRunMonteCarlo(const MonteCarloSpec& spec) {
+  const MonteCarloStatistics stats = RunMonteCarlo(spec);
+  ASSERT_FALSE(stats.cancelled());
+  const std::vector<CheckpointValues>& checkpoints = stats.data().checkpoints;
+  ASSERT_EQ(checkpoints.size(), 3u);
+  for (uint32_t run = 0; run < spec.runs; ++run) {
+    const NavEnvironment* env = nullptr;
+    int seen = 0;
+    const bool done = ReplayMonteCarloRun(
+        spec, run, /*navigate=*/true, [&](const MonteCarloRunLayout& l) { env = l.env; },
+        [&](const MonteCarloRunStep& step) {
+          if (step.checkpoint < 0) return;
+          ASSERT_NE(step.nav, nullptr) << step.k;
+          const ErrorComponentValues v =
+              ErrorComponentsOf(ComputeNavError(*env, *step.nav, *step.truth));
+          const CheckpointValues& cp = checkpoints[static_cast<size_t>(step.checkpoint)];
+          EXPECT_EQ(step.report_t_s, cp.t_s);
+          for (int c = 0; c < kNumErrorComponents; ++c) {
+            EXPECT_EQ(std::bit_cast<uint64_t>(v[c]), std::bit_cast<uint64_t>(cp.values[run][c]))
+                << "run " << run << " checkpoint " << step.checkpoint << " component " << c;
+          }
+          ++seen;
+        },
+        nullptr);
+    EXPECT_TRUE(done);
+    EXPECT_EQ(seen, 3);
+  }
+}
+
+TEST(RunLoopTest, ReplayedFreeNedRunScoresAsRunMonteCarlo) {
+  ExpectReplayScoresAsRunMonteCarlo(SmallJob());
+}
+
+TEST(RunLoopTest, ReplayedStaticAlignmentRunWithTruthHeightScoresAsRunMonteCarlo) {
+  MonteCarloSpec spec = SmallJob();
+  spec.initialization = InitializationKind::kStaticAlignment;
+  spec.alignment.duration_s = 15.0;
+  spec.initial_errors.attitude_rad = Vector3d::Zero();
+  spec.simulation.ned.vertical = VerticalChannel::kTruthHeight;
+  ExpectReplayScoresAsRunMonteCarlo(spec);
+}
+
+TEST(RunLoopTest, ReplayedSeed000RunScoresAsRunMonteCarlo) {
+  MonteCarloSpec spec = SmallJob();
+  spec.simulation.mechanization = MechanizationKind::kSeed000;
+  spec.simulation.seed000.static_period_s = 15.0;
+  spec.initial_errors = InitialErrorSigmas();
+  ExpectReplayScoresAsRunMonteCarlo(spec);
+}
+
+// RunSimulation of (seed, run) and the replay of run `run` of a job with that seed: the same
+// measured IMU data at every sample and, for mechanization B (which starts from its own static
+// period in both), the same navigation solution, to the bit.
+TEST(RunLoopTest, SimulationOfARunEqualsItsReplay) {
+  for (const MechanizationKind mechanization :
+       {MechanizationKind::kNed, MechanizationKind::kSeed000}) {
+    MonteCarloSpec spec = SmallJob();
+    spec.initial_errors = InitialErrorSigmas();
+    spec.simulation.mechanization = mechanization;
+    spec.simulation.seed000.static_period_s = 15.0;
+    const uint32_t run = 2;
+    const bool seed000 = mechanization == MechanizationKind::kSeed000;
+    std::vector<ImuIncrement> increments;
+    std::vector<ImuSample> samples;
+    std::vector<NavState> navs;
+    const SensorRun sensor{*spec.sensor, spec.seed, run};
+    const SimulationSummary summary =
+        RunSimulation(spec.simulation, &sensor, [&](const SimulationStep& step) {
+          increments.push_back(*step.measured_increment);
+          samples.push_back(*step.measured_sample);
+          navs.push_back(*step.nav);
+        });
+    ASSERT_EQ(summary.steps, 1200);
+    ASSERT_EQ(increments.size(), 1201u);
+    int64_t steps = 0;
+    ReplayMonteCarloRun(
+        spec, run, /*navigate=*/seed000, nullptr,
+        [&](const MonteCarloRunStep& step) {
+          const size_t k = static_cast<size_t>(step.k);
+          ASSERT_EQ(step.k, steps++);
+          ASSERT_LT(k, increments.size());
+          EXPECT_EQ(step.measured_increment->delta_theta_ib_b, increments[k].delta_theta_ib_b);
+          EXPECT_EQ(step.measured_increment->delta_v_ib_b, increments[k].delta_v_ib_b);
+          EXPECT_EQ(step.measured_sample->omega_ib_b, samples[k].omega_ib_b);
+          EXPECT_EQ(step.measured_sample->f_ib_b, samples[k].f_ib_b);
+          if (step.nav == nullptr) return;
+          EXPECT_EQ(step.nav->llh.lat_rad, navs[k].llh.lat_rad) << k;
+          EXPECT_EQ(step.nav->llh.lon_rad, navs[k].llh.lon_rad) << k;
+          EXPECT_EQ(step.nav->llh.h_m, navs[k].llh.h_m) << k;
+          EXPECT_EQ(step.nav->v_eb_n, navs[k].v_eb_n) << k;
+          EXPECT_EQ(step.nav->q_b_n.coeffs(), navs[k].q_b_n.coeffs()) << k;
+        },
+        nullptr);
+    EXPECT_EQ(steps, 1201);
+  }
+}
+
+// The cancel flag set at sample 1500 stops the replay after the poll at sample 2048.
+TEST(RunLoopTest, ReplayStopsAtTheFirstPollAfterCancel) {
+  MonteCarloSpec spec = SmallJob();
+  spec.simulation.rate_hz = 100.0;  // 6000 samples
+  std::atomic<bool> cancel{false};
+  int64_t last_k = -1;
+  const bool done = ReplayMonteCarloRun(
+      spec, 0, /*navigate=*/true, nullptr,
+      [&](const MonteCarloRunStep& step) {
+        last_k = step.k;
+        if (step.k == 1500) cancel = true;
+      },
+      &cancel);
+  EXPECT_FALSE(done);
+  EXPECT_EQ(last_k, 2048);
+}
+
+}  // namespace
+}  // namespace driftlab
