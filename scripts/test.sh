@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs dependencies, builds driftlab with its tests and benchmarks, and runs every test: the
-# README's test command.
+# README's test command. Prints the machine factor (scripts/ci/machine_factor.sh: how much slower
+# than the reference machine this one is) and the time of each step, so a slow machine is visible.
 # Usage: scripts/test.sh [BUILD_DIR] [--build-only]
 #   extra CMake flags in $DRIFTLAB_CMAKE_FLAGS, extra ctest flags in $DRIFTLAB_CTEST_FLAGS.
 set -euo pipefail
@@ -13,10 +14,28 @@ for arg in "$@"; do
     *) build_dir="$arg" ;;
   esac
 done
+times=()
+step_start=$(date +%s)
+done_step() {
+  times+=("$(printf '%-10s %5d s' "$1" $(($(date +%s) - step_start)))")
+  step_start=$(date +%s)
+}
+report() {
+  echo "=== test.sh: machine factor ${factor:-not measured}; times:"
+  if [ "${#times[@]}" -gt 0 ]; then printf '  %s\n' "${times[@]}"; fi
+}
+trap report EXIT
+
 bash bootstrap.sh
+done_step packages
+factor=$(bash scripts/ci/machine_factor.sh)
+done_step factor
 # shellcheck disable=SC2086
 cmake -S . -B "$build_dir" -G Ninja ${DRIFTLAB_CMAKE_FLAGS:-}
+done_step configure
 cmake --build "$build_dir" --parallel "$(nproc)"
+done_step build
 if [ "$build_only" -eq 1 ]; then exit 0; fi
 # shellcheck disable=SC2086
 ctest --test-dir "$build_dir" --output-on-failure --parallel "$(nproc)" ${DRIFTLAB_CTEST_FLAGS:-}
+done_step test
