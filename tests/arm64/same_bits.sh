@@ -64,14 +64,23 @@ fi
 
 echo "--- engine sources through $cross"
 failed=0
-# Every source compiled (-O0: parsing, templates instantiated and code generated; ccache caches
-# compilations, not -fsyntax-only), the lockstep kernels with their own options.
-mkdir -p "$work/obj"
+# Every source through the compiler's front end (-fsyntax-only: parsing, templates instantiated).
+# A source whose preprocessed text, compiler and options were checked before is not checked again:
+# its result is kept in a stamp file named by the hash of all three (what ccache does for object
+# files, which it cannot do for -fsyntax-only), so an unchanged engine costs the preprocessing.
+# Paths are taken out of the key, so clones of the same sources share the stamps.
+stamps="${XDG_CACHE_HOME:-$HOME/.cache}/driftlab/arm64-syntax"
+mkdir -p "$stamps"
+export stamps src
 # shellcheck disable=SC2016
 find "$src/engine/src" -name '*.cc' | sort | xargs -P "$(nproc)" -I{} sh -c '
-  o="'"$work"'/obj/$(echo "{}" | sed "s|^'"$src"'/||; s|/|_|g").o"
-  "$0" "$@" -O0 -c -isystem "'"$work"'/include" -DDRIFTLAB_VERSION=\"0\" {} -o "$o" ||
-    { echo "FAILED: {}"; exit 1; }' "${launcher[@]}" "$cross" "${common[@]}" || failed=1
+  set -- "$@"
+  key=$( { "$0" --version; echo "$*"; "$0" "$@" -E -isystem "'"$work"'/include" \
+    -DDRIFTLAB_VERSION=\"0\" {} | grep -v "^# "; } | sed "s|$src||g" | sha256sum | cut -c1-32)
+  [ -f "$stamps/$key" ] && exit 0
+  "$0" "$@" -fsyntax-only -isystem "'"$work"'/include" -DDRIFTLAB_VERSION=\"0\" {} ||
+    { echo "FAILED: {}"; exit 1; }
+  touch "$stamps/$key"' "$cross" "${common[@]}" || failed=1
 for f in $(find "$src/engine/src" -name 'lockstep_ned_*.cc' ! -name '*kernel*' | sort); do
   "${launcher[@]}" "$cross" "${common[@]}" "${kernel_options[@]}" -isystem "$work/include" -c \
     "$f" -o "$work/$(basename "$f" .cc).o" || failed=1
