@@ -10,6 +10,7 @@
 #include "driftlab/app/translate.h"
 #include "driftlab/earth.h"
 #include "driftlab/report/html_report.h"
+#include "driftlab/sensor_terms.h"
 #include "driftlab/trajectory.h"
 #include "driftlab/units.h"
 #include "report_style.h"
@@ -25,23 +26,33 @@ std::string Fact(const std::string& name, const std::string& value) {
   return "<tr><th>" + EscapeHtml(name) + "</th><td>" + EscapeHtml(value) + "</td></tr>\n";
 }
 
-std::string TriadFigures(const TriadErrorParams& t, bool gyro) {
-  // Datasheet units (units.h): deg/h and deg/sqrt(h) for gyros, ug / mg and m/s/sqrt(h) for
-  // accelerometers, ppm, mrad.
-  const char* bias = gyro ? "deg/h" : "ug";
+// The IMU figures of triad t in the report units of the sensor-term table (sensor_terms.h): the
+// scalar terms in the table's order (a correlation time only with its sigma), then the norms of
+// the vector terms; terms that are off are left out.
+std::string TriadFigures(const ImuErrorModel& model, SensorTriad t) {
   std::vector<std::string> parts;
-  const auto add = [&](const char* name, double si, const char* unit) {
+  const auto add = [&](std::string_view name, double si, std::string_view unit) {
     if (si != 0) parts.push_back(fmt::format("{} {}", name, FormatQuantity(si, unit, 3)));
   };
-  add(gyro ? "ARW" : "VRW", t.white_noise_density, gyro ? "deg/sqrt(h)" : "m/s/sqrt(h)");
-  add("bias instability", t.bias_flicker.bias_instability, bias);
-  add("turn-on bias 1σ", t.turn_on_bias_sigma, bias);
-  add("Gauss-Markov bias 1σ", t.bias_gauss_markov.sigma, bias);
-  if (t.bias_gauss_markov.sigma != 0) add("τ", t.bias_gauss_markov.tau_s, "s");
-  add(gyro ? "RRW" : "AcRW", t.random_walk, gyro ? "deg/h/sqrt(h)" : "ug/sqrt(s)");
-  add("scale factor 1σ", t.scale_factor_sigma, "ppm");
-  add("misalignment 1σ", t.misalignment_sigma_rad, "mrad");
-  if (t.fixed_bias.norm() != 0) add("fixed bias |b|", t.fixed_bias.norm(), bias);
+  for (const bool vectors : {false, true}) {
+    for (const SensorTerm& term : SensorTerms()) {
+      const std::string_view label = term.report_label.of(t);
+      if (label.empty() || !term.applies_to(t)) continue;
+      if (term.written_with != 0 &&
+          TermValue(*SensorTermByField(term.written_with), model, t, 0) == 0) {
+        continue;
+      }
+      const int count = TermValueCount(term.shape);
+      if ((count > 1) != vectors) continue;
+      double sum_of_squares = 0;
+      for (int i = 0; i < count; ++i) {
+        const double v = TermValue(term, model, t, i);
+        sum_of_squares += v * v;
+      }
+      add(label, count == 1 ? TermValue(term, model, t, 0) : std::sqrt(sum_of_squares),
+          term.report_unit.of(t));
+    }
+  }
   return parts.empty() ? "ideal" : fmt::format("{}", fmt::join(parts, ", "));
 }
 
@@ -138,8 +149,8 @@ std::string SetupTable(const v1::JobResult& result, const Scenario& scenario) {
       rows += Fact("IMU model", "ideal (no sensor errors)");
     } else {
       rows += Fact("IMU model", model->name.empty() ? "(custom)" : model->name);
-      rows += Fact("gyro", TriadFigures(model->gyro, true));
-      rows += Fact("accelerometer", TriadFigures(model->accel, false));
+      rows += Fact("gyro", TriadFigures(*model, SensorTriad::kGyro));
+      rows += Fact("accelerometer", TriadFigures(*model, SensorTriad::kAccel));
     }
   } catch (const std::exception& e) {
     rows += Fact("IMU model", e.what());
