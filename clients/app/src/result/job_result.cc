@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "driftlab/app/result_check.h"
 #include "driftlab/ins_gnss_filter.h"
 #include "driftlab/spec_error.h"
 
@@ -296,10 +297,20 @@ MonteCarloStatistics StatisticsFromJobResult(const v1::JobResult& result,
   return MonteCarloStatistics(std::move(data), source);
 }
 
+void SetFilterConsistencyFromSums(const v1::JobResult& result, const std::string& source,
+                                  v1::JobResult* out) {
+  std::vector<double> times;
+  for (const v1::EpochStatistics& epoch : result.epochs()) times.push_back(epoch.t_s());
+  SetConsistency(ConsistencyFromJobResult(result, source), times, out);
+}
+
 v1::JobResult MergeJobResults(const std::vector<v1::JobResult>& shards,
                               const std::vector<std::string>& sources,
                               const std::string& engine_version) {
   if (shards.empty()) throw SpecError("SHARD", "none", "at least one result file");
+  // The merge adds the shards' exact sums: each shard's statistics must be what its sums and
+  // per-run values give, or the merged result would silently differ from every shard.
+  for (size_t i = 0; i < shards.size(); ++i) VerifyResultStatistics(shards[i], sources[i]);
   for (size_t i = 1; i < shards.size(); ++i) {
     if (!google::protobuf::util::MessageDifferencer::Equals(shards[i].job(), shards[0].job())) {
       throw SpecError(sources[i], "a result of a different job (its job echo differs)",

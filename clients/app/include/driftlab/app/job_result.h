@@ -37,6 +37,11 @@ void FillCheckpointSummaries(v1::JobResult* result);
 MonteCarloStatistics StatisticsFromJobResult(const v1::JobResult& result,
                                              const std::string& source);
 
+// `out`'s filter_consistency (and merge-state NEES sums) computed from `result`'s merge-state NEES
+// sums and counts, as ToJobResult writes them. Throws SpecError naming `source`.
+void SetFilterConsistencyFromSums(const v1::JobResult& result, const std::string& source,
+                                  v1::JobResult* out);
+
 // Merges shards of one job (any order, any grouping) into one result: the same job echo, seed
 // and epochs are required and the runs must be disjoint and together contiguous. `sources` name
 // the inputs in errors. Throws SpecError.
