@@ -85,13 +85,30 @@ TEST(SensorTermsSchemaTest, EachTermAloneRoundTripsThroughItsOwnField) {
           if (stored) SetTermValue(term, &model, t, i, si * (1 + i));
         }
       }
+      // Its parts that a model with the term on requires (a Gauss-Markov tau): 10 s.
+      for (const SensorTerm& part : SensorTerms()) {
+        if (part.written_with == term.proto_field && TermValue(part, model, t, 0) == 0) {
+          SetTermValue(part, &model, t, 0, 10.0);
+        }
+      }
       const v1::SensorModel proto = ToSensorModelProto(model);
       const google::protobuf::Message& triad =
           t == SensorTriad::kGyro ? static_cast<const google::protobuf::Message&>(proto.gyro())
                                   : proto.accel();
       std::vector<const FieldDescriptor*> set;
       triad.GetReflection()->ListFields(triad, &set);
-      ASSERT_EQ(static_cast<int>(set.size()), expected_fields) << term.param;
+      // The term's own field is written, and nothing but it, the term it belongs to (a sigma for
+      // its correlation time) and their parts (a flicker band with its B, at its defaults).
+      const int group = term.written_with != 0 ? term.written_with : term.proto_field;
+      bool own = false;
+      for (const FieldDescriptor* f : set) {
+        const SensorTerm& written = *SensorTermByField(f->number());
+        own |= f->number() == term.proto_field;
+        EXPECT_TRUE(written.proto_field == group || written.written_with == group)
+            << term.param << " wrote " << f->name();
+      }
+      ASSERT_TRUE(own) << term.param << " not written";
+      EXPECT_GE(static_cast<int>(set.size()), expected_fields) << term.param;
       const ImuErrorModel back = ToImuErrorModel(proto, "sensor");
       if (term.shape == TermShape::kFlag) {
         EXPECT_TRUE(*term.flag(const_cast<ImuErrorModel*>(&back), t)) << term.param;
