@@ -1,12 +1,15 @@
 // Fuzz target: result files (fuzz_targets.h), as `report`, `gate` and `merge` read them. The input
 // is two result texts separated by a NUL byte (a JSON text holds none): each is parsed and
-// validated (ParseJobResultJson) and rendered (RenderHtmlReport); the pair is gated (RunGate with
+// validated (ParseJobResultJson), rendered (RenderHtmlReport) and its statistics checked against
+// its sums (VerifyResultStatistics); the pair of checked results is gated (RunGate with
 // the default rules, its table and JUnit XML) and merged as two shards (MergeJobResults).
 #include <optional>
+#include <string>
 #include <string_view>
 
 #include "driftlab/app/gate.h"
 #include "driftlab/app/monte_carlo_job.h"
+#include "driftlab/app/result_check.h"
 #include "driftlab/app/result_file.h"
 #include "driftlab/report/html_report.h"
 #include "driftlab/spec_error.h"
@@ -16,14 +19,22 @@
 namespace driftlab::fuzz {
 namespace {
 
+// The result if it is valid and its statistics agree with its sums and per-run values (what
+// `gate` and `merge` require); a valid result is rendered either way.
 std::optional<v1::JobResult> ReadOne(std::string_view text, std::string_view source) {
+  v1::JobResult result;
   try {
-    v1::JobResult result = app::ParseJobResultJson(text, source);
+    result = app::ParseJobResultJson(text, source);
     app::RenderHtmlReport(result);
-    return result;
   } catch (const SpecError&) {
     return std::nullopt;
   }
+  try {
+    app::VerifyResultStatistics(result, std::string(source));
+  } catch (const SpecError&) {
+    return std::nullopt;
+  }
+  return result;
 }
 
 }  // namespace

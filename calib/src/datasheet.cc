@@ -6,12 +6,12 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
-#include <functional>
 #include <set>
 #include <sstream>
 
 #include "driftlab/calib/yaml_document.h"
 #include "driftlab/input_files.h"
+#include "driftlab/sensor_terms.h"
 #include "driftlab/sensors.h"
 #include "driftlab/spec_error.h"
 
@@ -19,7 +19,7 @@ namespace driftlab::calib {
 namespace {
 
 // Angular rate per acceleration (gyro g-sensitivity): rad s^-1 / (m s^-2) = rad m^-1 s.
-constexpr Dimension kRatePerAcceleration{2, -2, 2};
+constexpr Dimension kRatePerAcceleration = kRatePerAccelerationDimension;
 
 std::string_view Trim(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
@@ -69,46 +69,28 @@ std::string KeyText(const YAML::Node& key, std::string_view source) {
   return key.Scalar();
 }
 
-// What one key means.
+// What one key means: the term of the sensor-term table (sensor_terms.h) it gives, the dimension
+// its figure must have and the model field it sets (for messages).
 struct KeyRule {
   std::string_view key;
   Dimension dimension;
-  std::string_view field;  // model field (without the triad prefix)
-  std::function<void(TriadErrorParams*, double)> set;
+  std::string field;  // "gyro.white_noise_density", "gyro_g_sensitivity"
+  const SensorTerm* term;
 };
 
 std::vector<KeyRule> Rules(bool gyro) {
-  using P = TriadErrorParams;
-  const Dimension rate = gyro ? dims::kAngularRate : dims::kAcceleration;
-  const Dimension white = gyro ? dims::kAngleRandomWalk : dims::kVelocityRandomWalk;
-  const Dimension walk = gyro ? dims::kRateRandomWalk : dims::kAccelRandomWalk;
-  const Dimension quantum = gyro ? dims::kAngle : dims::kVelocity;
-  auto white_set = [](P* p, double v) { p->white_noise_density = v; };
-  std::vector<KeyRule> rules = {
-      {gyro ? "arw" : "vrw", white, "white_noise_density", white_set},
-      {gyro ? "rate_noise_density" : "noise_density", white, "white_noise_density", white_set},
-      {"bias_instability", rate, "bias_flicker.bias_instability",
-       [](P* p, double v) { p->bias_flicker.bias_instability = v; }},
-      {"bias_instability_tau_min", dims::kTime, "bias_flicker.tau_min_s",
-       [](P* p, double v) { p->bias_flicker.tau_min_s = v; }},
-      {"bias_instability_tau_max", dims::kTime, "bias_flicker.tau_max_s",
-       [](P* p, double v) { p->bias_flicker.tau_max_s = v; }},
-      {"gauss_markov_sigma", rate, "bias_gauss_markov.sigma",
-       [](P* p, double v) { p->bias_gauss_markov.sigma = v; }},
-      {"gauss_markov_tau", dims::kTime, "bias_gauss_markov.tau_s",
-       [](P* p, double v) { p->bias_gauss_markov.tau_s = v; }},
-      {gyro ? "rate_random_walk" : "acceleration_random_walk", walk, "random_walk",
-       [](P* p, double v) { p->random_walk = v; }},
-      {"turn_on_bias", rate, "turn_on_bias_sigma",
-       [](P* p, double v) { p->turn_on_bias_sigma = v; }},
-      {"scale_factor", dims::kDimensionless, "scale_factor_sigma",
-       [](P* p, double v) { p->scale_factor_sigma = v; }},
-      {"misalignment", dims::kAngle, "misalignment_sigma_rad",
-       [](P* p, double v) { p->misalignment_sigma_rad = v; }},
-      {"quantization", quantum, "quantization", [](P* p, double v) { p->quantization = v; }},
-      {"range", rate, "range", [](P* p, double v) { p->range = v; }},
-  };
-  if (gyro) rules.push_back({"g_sensitivity", kRatePerAcceleration, "gyro_g_sensitivity", nullptr});
+  const SensorTriad t = gyro ? SensorTriad::kGyro : SensorTriad::kAccel;
+  std::vector<KeyRule> rules;
+  for (const SensorTerm& term : SensorTerms()) {
+    if (!term.applies_to(t)) continue;
+    const Dimension dimension = term.figure_dimension(t);
+    const std::string field =
+        term.gyro_only ? std::string(term.param)
+                       : std::string(gyro ? "gyro." : "accel.") + std::string(term.param);
+    for (const std::string_view key : {term.datasheet_key.of(t), term.datasheet_alt_key.of(t)}) {
+      if (!key.empty()) rules.push_back({key, dimension, field, &term});
+    }
+  }
   return rules;
 }
 
@@ -229,8 +211,7 @@ DatasheetModel DatasheetToModel(const std::vector<DatasheetEntry>& entries) {
       throw SpecError(e.key, "unknown key (line " + std::to_string(e.line) + ")",
                       "one of: " + AllowedKeys(gyro));
     }
-    const std::string field =
-        rule->set ? triad + "." + std::string(rule->field) : std::string(rule->field);
+    const std::string& field = rule->field;
     if (!fields_set.insert(field).second) {
       throw SpecError(e.key, "'" + e.text + "'",
                       "one value for " + field +
@@ -276,11 +257,12 @@ DatasheetModel DatasheetToModel(const std::vector<DatasheetEntry>& entries) {
       throw SpecError(e.key, "'" + e.text + "'",
                       "a finite magnitude >= 0 in " + AllowedUnitsFor(rule->dimension));
     }
-    TriadErrorParams& params = gyro ? model.gyro : model.accel;
-    if (rule->set) {
-      rule->set(&params, value_si);
-    } else {
-      model.gyro_g_sensitivity = Eigen::Matrix3d::Identity() * value_si;
+    // A figure is a magnitude: a scalar term's value, or a matrix term's diagonal (a same-axis
+    // g-sensitivity).
+    const SensorTriad t = gyro ? SensorTriad::kGyro : SensorTriad::kAccel;
+    const int count = TermValueCount(rule->term->shape);
+    for (int i = 0; i < count; ++i) {
+      SetTermValue(*rule->term, &model, t, i, count == 1 || i % 4 == 0 ? value_si : 0.0);
     }
     out.values.push_back({e.key, e.text, value_si, SiUnitText(rule->dimension), field});
   }

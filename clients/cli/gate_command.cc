@@ -2,8 +2,9 @@
 //  [--junit FILE] [--allow-different-job]`: decides per metric whether RESULT is worse than
 // BASELINE by more than the tolerance, as a hypothesis test with family-wise error alpha (gate.h),
 // prints a table and exits 0 on pass, 1 on a regression (or, with --strict, an inconclusive
-// metric), 2 on bad input (unreadable or invalid result or rules, results of different jobs,
-// unwritable JUnit file).
+// metric), 2 on bad input (unreadable or invalid result or rules, a result whose statistics
+// disagree with its exact sums or per-run values (result_check.h), a result of fewer than 2 runs,
+// results of different jobs, unwritable JUnit file).
 // `driftlab gate RESULT --list-metrics` prints every metric name of RESULT with its value.
 // `driftlab gate RESULT --runs-for-change REL [--rules RULES] [--alpha A]` prints the runs per file
 // with which a sigma grown by REL (0.3 = +30 %) is a regression with 90 % power.
@@ -20,6 +21,7 @@
 
 #include "commands.h"
 #include "driftlab/app/gate.h"
+#include "driftlab/app/result_check.h"
 #include "driftlab/app/result_file.h"
 #include "driftlab/spec_error.h"
 
@@ -87,6 +89,7 @@ int RunGateCommand(const GateOptions& options) {
   app::GateReport report;
   try {
     const v1::JobResult current = app::ReadJobResult(options.result_path);
+    app::VerifyResultStatistics(current, options.result_path);
     if (options.list_metrics) {
       for (const app::Metric& metric : app::ListMetrics(current)) {
         fmt::print("{} {}\n", metric.name, metric.value);
@@ -101,10 +104,13 @@ int RunGateCommand(const GateOptions& options) {
       throw SpecError("--baseline", "", "a baseline result file (required unless --list-metrics)");
     }
     const v1::JobResult baseline = app::ReadJobResult(options.baseline_path);
+    app::VerifyResultStatistics(baseline, options.baseline_path);
     app::GateOptions gate_options;
     gate_options.alpha = options.alpha;
     gate_options.strict = options.strict;
     gate_options.allow_different_job = options.allow_different_job;
+    gate_options.baseline_name = options.baseline_path;
+    gate_options.current_name = options.result_path;
     report = app::RunGate(baseline, current, rules, gate_options);
     report.baseline_file = options.baseline_path;
     report.current_file = options.result_path;

@@ -2,10 +2,11 @@
 //
 // Without NAME: one row per preset with the headline figures (gyro bias instability in deg/h,
 // ARW in deg/sqrt(h), accel bias instability in ug or mg, VRW in m/s/sqrt(h), ranges). With NAME:
-// every parameter of that preset's error model (sensor_params.h) in a datasheet unit with the SI
-// value beside it, and the preset's description (source, revision, assumptions). All conversions
-// go through the units module (units.h FromSi / FormatQuantity). --json prints the same content
-// as JSON (google.protobuf.Struct printed by protobuf's JSON printer, which escapes strings).
+// every term of that preset's error model in the datasheet unit of the sensor-term table
+// (sensor_terms.h) with the SI value beside it, and the preset's description (source, revision,
+// assumptions). All conversions go through the units module (units.h FromSi / FormatQuantity).
+// --json prints the same content as JSON (google.protobuf.Struct printed by protobuf's JSON
+// printer, which escapes strings).
 #include <fmt/format.h>
 #include <google/protobuf/struct.pb.h>
 #include <google/protobuf/util/json_util.h>
@@ -21,6 +22,7 @@
 #include "commands.h"
 #include "driftlab/presets.h"
 #include "driftlab/sensor_params.h"
+#include "driftlab/sensor_terms.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/units.h"
 
@@ -30,42 +32,6 @@ namespace {
 namespace pb = google::protobuf;
 
 constexpr int kDigits = 6;  // significant digits of datasheet-unit values (trailing zeros dropped)
-
-// Datasheet and SI units of one triad's quantities: "u" is rad/s (gyro) or m/s^2 (accel).
-struct TriadUnits {
-  const char* bias;            // [u]
-  const char* bias_si;         // SI spelling of [u]
-  const char* noise;           // [u/sqrt(Hz)] as a random walk: deg/sqrt(h), m/s/sqrt(h)
-  const char* noise_density;   // [u/sqrt(Hz)] as a density: (deg/s)/sqrt(Hz), ug/sqrt(Hz)
-  const char* noise_si;        // rad/sqrt(s), m/s/sqrt(s)
-  const char* random_walk;     // [u sqrt(Hz)]
-  const char* random_walk_si;  // rad/s/sqrt(s), m/s^2/sqrt(s)
-  const char* quantization;    // [u s]
-  const char* quantization_si;
-  const char* range;  // [u]
-};
-
-constexpr TriadUnits kGyroUnits{"deg/h",       "rad/s",         "deg/sqrt(h)",   "(deg/s)/sqrt(Hz)",
-                                "rad/sqrt(s)", "deg/h/sqrt(h)", "rad/s/sqrt(s)", "urad",
-                                "rad",         "deg/s"};
-
-// Accelerometer biases read best in ug below 1 mg and in mg above (datasheet habit).
-const char* AccelBiasUnit(double value_si) {
-  return std::fabs(FromSi(value_si, "mg")) < 1.0 ? "ug" : "mg";
-}
-
-TriadUnits AccelUnits(double typical_bias_si) {
-  return TriadUnits{AccelBiasUnit(typical_bias_si),
-                    "m/s^2",
-                    "m/s/sqrt(h)",
-                    "ug/sqrt(Hz)",
-                    "m/s/sqrt(s)",
-                    "m/s/h/sqrt(h)",
-                    "m/s^2/sqrt(s)",
-                    "mm/s",
-                    "m/s",
-                    "g"};
-}
 
 std::string Datasheet(double value_si, const char* unit) {
   return FormatQuantity(value_si, unit, kDigits);
@@ -111,11 +77,12 @@ Row Scalar(std::string key, std::string label, double value_si, const char* unit
 }
 
 // A noise density printed both as a random walk and as a density.
-Row Noise(std::string key, std::string label, double value_si, const TriadUnits& u) {
-  Row row = Scalar(std::move(key), std::move(label), value_si, u.noise, u.noise_si);
-  row.datasheet += " = " + Datasheet(value_si, u.noise_density);
+Row Noise(std::string key, std::string label, double value_si, const char* unit,
+          const char* si_unit, const char* density_unit) {
+  Row row = Scalar(std::move(key), std::move(label), value_si, unit, si_unit);
+  row.datasheet += " = " + Datasheet(value_si, density_unit);
   (*row.json.mutable_struct_value()->mutable_fields())["datasheet_density"] =
-      Text(Datasheet(value_si, u.noise_density));
+      Text(Datasheet(value_si, density_unit));
   return row;
 }
 
@@ -144,38 +111,33 @@ Row Values(std::string key, std::string label, const double* values, int count, 
   return row;
 }
 
-std::vector<Row> TriadRows(const TriadErrorParams& p, const TriadUnits& u) {
+// The printed rows of the terms that apply to triad t (model-level terms when model_level: the
+// g-sensitivity), in the table's order (sensor_terms.h).
+std::vector<Row> TermRows(const ImuErrorModel& m, SensorTriad t, bool model_level) {
   std::vector<Row> rows;
-  rows.push_back(Noise("white_noise_density", "white noise", p.white_noise_density, u));
-  rows.push_back(Scalar("bias_instability", "bias instability B (flicker)",
-                        p.bias_flicker.bias_instability, u.bias, u.bias_si));
-  rows.push_back(Scalar("flicker_tau_min", "flicker tau min", p.bias_flicker.tau_min_s, "s", "s"));
-  rows.push_back(Scalar("flicker_tau_max", "flicker tau max", p.bias_flicker.tau_max_s, "s", "s"));
-  rows.push_back(Scalar("turn_on_bias_sigma", "turn-on bias (1 sigma)", p.turn_on_bias_sigma,
-                        u.bias, u.bias_si));
-  rows.push_back(
-      Values("fixed_bias", "fixed bias (x y z)", p.fixed_bias.data(), 3, u.bias, u.bias_si));
-  rows.push_back(Scalar("gauss_markov_sigma", "Gauss-Markov bias sigma", p.bias_gauss_markov.sigma,
-                        u.bias, u.bias_si));
-  rows.push_back(
-      Scalar("gauss_markov_tau", "Gauss-Markov bias tau", p.bias_gauss_markov.tau_s, "s", "s"));
-  rows.push_back(
-      Scalar("random_walk", "random walk", p.random_walk, u.random_walk, u.random_walk_si));
-  rows.push_back(
-      Scalar("scale_factor_sigma", "scale factor (1 sigma)", p.scale_factor_sigma, "ppm", ""));
-  rows.push_back(Values("scale_factor_fixed", "fixed scale factor (x y z)",
-                        p.scale_factor_fixed.data(), 3, "ppm", ""));
-  rows.push_back(Values("scale_factor_asymmetry", "scale-factor asymmetry (x y z)",
-                        p.scale_factor_asymmetry.data(), 3, "ppm", ""));
-  rows.push_back(Scalar("misalignment_sigma", "misalignment (1 sigma)", p.misalignment_sigma_rad,
-                        "mrad", "rad"));
-  // Row-major 3x3 (Eigen is column-major by default).
-  const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> misalignment = p.misalignment_fixed;
-  rows.push_back(Values("misalignment_fixed", "fixed misalignment (rows)", misalignment.data(), 9,
-                        "mrad", "rad"));
-  rows.push_back(Scalar("quantization", "quantization (increment LSB)", p.quantization,
-                        u.quantization, u.quantization_si));
-  rows.push_back(Scalar("range", "range (0 = unlimited)", p.range, u.range, u.bias_si));
+  for (const SensorTerm& term : SensorTerms()) {
+    if (term.preset_label.empty() || term.gyro_only != model_level || !term.applies_to(t)) {
+      continue;
+    }
+    const std::string key(term.preset_key), label(term.preset_label);
+    const std::string si_unit(term.preset_si_unit.of(t));
+    std::string unit(term.preset_unit.of(t));
+    if (term.preset_bias_unit && t == SensorTriad::kAccel) {
+      unit = AccelBiasPrintUnit(m.accel.bias_flicker.bias_instability);
+    }
+    const int count = TermValueCount(term.shape);
+    if (count == 1) {
+      const double value = TermValue(term, m, t, 0);
+      const std::string density(term.preset_density_unit.of(t));
+      rows.push_back(density.empty() ? Scalar(key, label, value, unit.c_str(), si_unit.c_str())
+                                     : Noise(key, label, value, unit.c_str(), si_unit.c_str(),
+                                             density.c_str()));
+      continue;
+    }
+    double values[9];
+    for (int i = 0; i < count; ++i) values[i] = TermValue(term, m, t, i);
+    rows.push_back(Values(key, label, values, count, unit.c_str(), si_unit.c_str()));
+  }
   return rows;
 }
 
@@ -186,21 +148,16 @@ pb::Value RowsToJson(const std::vector<Row>& rows) {
   return value;
 }
 
-Row GSensitivityRow(const ImuErrorModel& model) {
-  const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> g = model.gyro_g_sensitivity;
-  return Values("gyro_g_sensitivity", "g-sensitivity (rows)", g.data(), 9, "(deg/h)/g",
-                "(rad/s)/(m/s^2)");
-}
-
 pb::Value PresetJson(const ImuErrorModel& model) {
   pb::Value value;
   pb::Struct& s = *value.mutable_struct_value();
   (*s.mutable_fields())["name"] = Text(model.name);
   (*s.mutable_fields())["description"] = Text(model.description);
-  (*s.mutable_fields())["gyro"] = RowsToJson(TriadRows(model.gyro, kGyroUnits));
-  (*s.mutable_fields())["accel"] =
-      RowsToJson(TriadRows(model.accel, AccelUnits(model.accel.bias_flicker.bias_instability)));
-  (*s.mutable_fields())["gyro_g_sensitivity"] = GSensitivityRow(model).json;
+  (*s.mutable_fields())["gyro"] = RowsToJson(TermRows(model, SensorTriad::kGyro, false));
+  (*s.mutable_fields())["accel"] = RowsToJson(TermRows(model, SensorTriad::kAccel, false));
+  for (const Row& row : TermRows(model, SensorTriad::kGyro, true)) {
+    (*s.mutable_fields())[row.key] = row.json;
+  }
   return value;
 }
 
@@ -273,7 +230,7 @@ int PrintTable() {
     const double accel_bi = m.accel.bias_flicker.bias_instability;
     rows.push_back({m.name, Cell(m.gyro.bias_flicker.bias_instability, "deg/h"),
                     Cell(m.gyro.white_noise_density, "deg/sqrt(h)"),
-                    Cell(accel_bi, AccelBiasUnit(accel_bi)),
+                    Cell(accel_bi, std::string(AccelBiasPrintUnit(accel_bi)).c_str()),
                     Cell(m.accel.white_noise_density, "m/s/sqrt(h)"),
                     m.gyro.range > 0.0 ? FormatQuantity(m.gyro.range, "deg/s", 4) : "unlimited",
                     m.accel.range > 0.0 ? FormatQuantity(m.accel.range, "g", 4) : "unlimited",
@@ -316,11 +273,11 @@ void PrintRows(const char* title, const std::vector<Row>& rows) {
 
 int PrintPreset(const ImuErrorModel& m) {
   fmt::print("{}\n{}\n", m.name, Wrap(m.description, 100, 2));
-  PrintRows("gyro", TriadRows(m.gyro, kGyroUnits));
+  PrintRows("gyro", TermRows(m, SensorTriad::kGyro, false));
   fmt::print("\n");
-  PrintRows("accelerometer", TriadRows(m.accel, AccelUnits(m.accel.bias_flicker.bias_instability)));
+  PrintRows("accelerometer", TermRows(m, SensorTriad::kAccel, false));
   fmt::print("\n");
-  PrintRows("gyro g-sensitivity", {GSensitivityRow(m)});
+  PrintRows("gyro g-sensitivity", TermRows(m, SensorTriad::kGyro, true));
   return kExitOk;
 }
 

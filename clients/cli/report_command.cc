@@ -10,6 +10,7 @@
 #include <string>
 
 #include "commands.h"
+#include "driftlab/app/result_check.h"
 #include "driftlab/app/result_file.h"
 #include "driftlab/report/html_report.h"
 #include "driftlab/spec_error.h"
@@ -25,7 +26,9 @@ struct ReportOptions {
 int RunReport(const ReportOptions& options) {
   std::string html;
   try {
-    html = app::RenderHtmlReport(app::ReadJobResult(options.result_path));
+    const v1::JobResult result = app::ReadJobResult(options.result_path);
+    app::VerifyResultStatistics(result, options.result_path);
+    html = app::RenderHtmlReport(result);
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;

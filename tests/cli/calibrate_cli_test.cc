@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "support/accel_tumble.h"
 #include "support/cli_runner.h"
 
 namespace driftlab::testing {
@@ -117,6 +118,66 @@ TEST(CalibrateCli, StaticOnlyRecordingHasTooFewPoses) {
       {"calibrate", "accel", data, "--out", (scratch.dir() / "c.json").string()}, scratch);
   EXPECT_EQ(r.exit_status, 2);
   EXPECT_NE(r.err.find("too few poses: 1 static pose found"), std::string::npos) << r.err;
+}
+
+// Writes AccelTumbleRows with the columns in `order` (indices into t_s, gx, gy, gz, ax, ay, az)
+// under the header `header`.
+void WriteTumble(const std::string& path, const std::string& header, const std::vector<int>& order,
+                 double noise, double clip) {
+  const double b[3] = {0.05, -0.08, 0.12};
+  std::ofstream out(path);
+  out << header << "\n";
+  for (const auto& row : AccelTumbleRows(b, noise, clip)) {
+    for (size_t i = 0; i < order.size(); ++i) {
+      char field[40];
+      std::snprintf(field, sizeof field, "%.17g", row[order[i]]);
+      out << (i ? "," : "") << field;
+    }
+    out << "\n";
+  }
+}
+
+const std::vector<int> kNamedOrder = {0, 1, 2, 3, 4, 5, 6};
+
+TEST(CalibrateCli, ClippedRecordingIsRefusedNamingTheColumn) {
+  Scratch scratch;
+  const std::string data = (scratch.dir() / "clipped.csv").string();
+  // Noise 2 mg; the sensor saturates at 0.8 g = 7.845 m/s^2, below the 1 g of its poses.
+  WriteTumble(data, "t_s,gx,gy,gz,ax,ay,az", kNamedOrder, 0.02, 0.8 * 9.80665);
+  const auto out = scratch.dir() / "calib.json";
+  const Result r =
+      RunDriftlab({"calibrate", "accel", data, "--lat", "45", "--out", out.string()}, scratch);
+  EXPECT_EQ(r.exit_status, 2) << r.out;
+  EXPECT_NE(r.err.find("data: column 'a"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("clipped at "), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  // The same recording unclipped calibrates (noise 2 mg: the flat-top check does not fire).
+  WriteTumble(data, "t_s,gx,gy,gz,ax,ay,az", kNamedOrder, 0.02, 0.0);
+  const Result ok =
+      RunDriftlab({"calibrate", "accel", data, "--lat", "45", "--out", out.string()}, scratch);
+  EXPECT_EQ(ok.exit_status, 0) << ok.err;
+}
+
+TEST(CalibrateCli, ColumnsAreReadByTheirHeaderNames) {
+  Scratch scratch;
+  const std::string data = (scratch.dir() / "accel_first.csv").string();
+  // Accelerometer columns first, as the header says: read by name, the fit recovers the bias.
+  WriteTumble(data, "t_s,ax,ay,az,gx,gy,gz", {0, 4, 5, 6, 1, 2, 3}, 0.0, 0.0);
+  const auto out = scratch.dir() / "calib.json";
+  const Result r =
+      RunDriftlab({"calibrate", "accel", data, "--lat", "45", "--out", out.string()}, scratch);
+  ASSERT_EQ(r.exit_status, 0) << r.err << r.out;
+  // Noise-free data: exact to the 6-digit gravity constant (|delta g| <= 5e-6 m/s^2).
+  EXPECT_NEAR(ValueOf(ReadFile(out), "accel.bias.x", "value"), 0.05, 1e-4);
+  // A header that does not name the expected columns is refused, naming what is missing.
+  WriteTumble(data, "time,gx,gy,gz,ax,ay,az", kNamedOrder, 0.0, 0.0);
+  const Result bad =
+      RunDriftlab({"calibrate", "accel", data, "--lat", "45", "--out", out.string()}, scratch);
+  EXPECT_EQ(bad.exit_status, 2);
+  EXPECT_NE(bad.err.find("data: header: time, gx, gy, gz, ax, ay, az (missing t_s) (unknown "
+                         "time) is not allowed"),
+            std::string::npos)
+      << bad.err;
 }
 
 }  // namespace

@@ -391,8 +391,10 @@ TEST(CalibrationCore, BadSettingsAndTablesNameTheFieldAndTheValue) {
   s.lat_deg = 91;
   EXPECT_NE(ErrorOf([&] { RunCalibration(s, table); }).find("lat_deg: 91"), std::string::npos);
   s = ImuSettings();
-  s.rate_hz = 100;  // then 6 columns without t_s are expected
-  EXPECT_NE(ErrorOf([&] { RunCalibration(s, table); }).find("data: 7 columns"), std::string::npos);
+  s.rate_hz = 100;  // then the header must name gx, gy, gz, ax, ay, az without t_s
+  EXPECT_NE(ErrorOf([&] { RunCalibration(s, table); }).find("data: header: t_s, gx"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { RunCalibration(s, table); }).find("(unknown t_s)"), std::string::npos);
   NumericTable bad = table;
   bad.values[7 * 100 + 4] = NAN;
   EXPECT_NE(ErrorOf([&] { RunCalibration(ImuSettings(), bad); }).find("row 101 column 'ax'"),

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <regex>
 #include <sstream>
 #include <string>
 
@@ -285,6 +286,43 @@ TEST(ResultFile, ValidationNamesTheFieldPath) {
   v1::JobResult no_runs = MakeResult(1.0);
   for (v1::Checkpoint& checkpoint : *no_runs.mutable_checkpoints()) checkpoint.clear_runs();
   EXPECT_EQ(ErrorOf([&] { ValidateJobResult(no_runs); }), "");
+}
+
+TEST(HtmlReport, ExtremeValuesRenderWithoutNonFinite) {
+  // A structurally valid result holding means of +-1e308 (the CLI refuses it: its per-run values
+  // do not give them; the renderer must still cope): fmt must not see a negative precision, and
+  // neither the text nor the plot data hold a non-finite number.
+  const std::string json = Slurp(kData / "gate_baseline.json");
+  const std::regex mean(R"re("mean": [-0-9.eE+]+)re");
+  std::string text;
+  size_t copied = 0;
+  int k = 0;
+  for (auto it = std::sregex_iterator(json.begin(), json.end(), mean); it != std::sregex_iterator();
+       ++it, ++k) {
+    text += json.substr(copied, it->position() - copied);
+    text += std::string("\"mean\": ") + (k % 2 ? "-" : "") + "1e308";
+    copied = it->position() + it->length();
+  }
+  text += json.substr(copied);
+  const std::string page = RenderHtmlReport(ParseJobResultJson(text, "extreme.json"));
+  EXPECT_NE(page.find("</html>"), std::string::npos);
+  const std::string markup = ::driftlab::testing::WithoutScriptText(page);
+  EXPECT_EQ(markup.find("nan"), std::string::npos);
+  EXPECT_EQ(markup.find("inf"), std::string::npos);
+  int plots = 0;
+  for (size_t at = page.find("<script>driftlabPlot("); at != std::string::npos;
+       at = page.find("<script>driftlabPlot(", at + 1)) {
+    const std::string call = page.substr(at, page.find("</script>", at) - at);
+    // As a value: after ",", "[" or ":" (the key "info" holds "inf").
+    for (const char* before : {",", "[", ":", "-"}) {
+      for (const char* bad : {"nan", "NaN", "inf", "Infinity"}) {
+        EXPECT_EQ(call.find(std::string(before) + bad), std::string::npos)
+            << bad << " in " << call.substr(0, 80);
+      }
+    }
+    ++plots;
+  }
+  EXPECT_GE(plots, 23);
 }
 
 TEST(ResultFile, OneRunResultHasUndefinedSigma) {

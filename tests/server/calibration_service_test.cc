@@ -3,6 +3,7 @@
 // stream protocol's errors.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -12,6 +13,7 @@
 #include "driftlab/random.h"
 #include "driftlab/server/data_services.h"
 #include "in_process_server.h"
+#include "support/accel_tumble.h"
 
 namespace driftlab {
 namespace {
@@ -257,6 +259,43 @@ TEST_F(CalibrationServiceTest, MalformedStreamsAreInvalidArgumentNamingTheField)
   const grpc::Status status = FitNoise({bad_rate, rows}, &fit);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_EQ(status.error_message().rfind("settings.rate_hz: -1", 0), 0u) << status.error_message();
+}
+
+// A recording clipped below 1 g (a saturated accelerometer) is refused as through the CLI, and the
+// columns are taken by their names (accelerometer columns first here).
+TEST_F(CalibrationServiceTest, ClippedRecordingIsRefusedAndColumnsAreReadByName) {
+  const double b[3] = {0.05, -0.08, 0.12};
+  v1::CalibrateSettings settings;
+  settings.set_kind("accel");
+  settings.set_lat_deg(45.0);
+  for (const char* c : {"t_s", "ax", "ay", "az", "gx", "gy", "gz"}) settings.add_columns(c);
+  const auto rows = [](const std::vector<std::array<double, 7>>& in) {
+    v1::CalibrateRequest r;
+    for (const auto& row : in) {
+      for (const int i : {0, 4, 5, 6, 1, 2, 3}) r.mutable_rows()->add_values(row[i]);
+    }
+    return r;
+  };
+  v1::CalibrationResult result;
+  // Noise 2 mg, clipped at 0.8 g.
+  grpc::Status status = Calibrate(
+      {Settings(settings), rows(testing::AccelTumbleRows(b, 0.02, 0.8 * 9.80665))}, &result);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_NE(status.error_message().find("clipped at "), std::string::npos)
+      << status.error_message();
+  // Noise-free and not clipped: the bias is recovered to the 6-digit gravity constant.
+  status = Calibrate({Settings(settings), rows(testing::AccelTumbleRows(b))}, &result);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  bool found = false;
+  for (const auto& fit : result.fits()) {
+    for (const auto& p : fit.parameters()) {
+      if (p.name() == "accel.bias.x") {
+        EXPECT_NEAR(p.value(), b[0], 1e-4);
+        found = true;
+      }
+    }
+  }
+  EXPECT_TRUE(found);
 }
 
 TEST_F(CalibrationServiceTest, StreamBeyondTheUploadValueLimitIsResourceExhausted) {

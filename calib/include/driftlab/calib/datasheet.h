@@ -14,25 +14,13 @@
 //     range: "±400 deg/s"
 //   accel: {vrw: "0.06 m/s/√h", bias_instability: "0.05 mg", range: "±10 g"}
 //
-// Keys of `gyro` (dimension; model field):
-//   arw | rate_noise_density   angle random walk (deg/√h, (deg/s)/√Hz, ...); white_noise_density
-//   bias_instability           angular rate (deg/h, ...); bias_flicker.bias_instability (Allan
-//                              minimum / 0.664, IEEE Std 952-1997 C.1)
-//   bias_instability_tau_min, bias_instability_tau_max   time (s, min, h); the flicker band,
-//                              default 1 s and 1000 s as the catalogue presets
-//   gauss_markov_sigma, gauss_markov_tau   angular rate, time; bias_gauss_markov
-//   rate_random_walk           (deg/h)/√h, ...; random_walk
-//   turn_on_bias               angular rate; turn_on_bias_sigma (bias repeatability, 1 sigma)
-//   scale_factor               ratio (ppm, %); scale_factor_sigma
-//   misalignment               angle (mrad, deg, ...); misalignment_sigma_rad
-//   quantization               angle (urad, arcsec, ...); quantization (LSB of the increment)
-//   range                      angular rate; range
-//   g_sensitivity              angular rate per acceleration ((deg/h)/g, (deg/s)/g); gyro
-//                              g-sensitivity, on the diagonal
-// Keys of `accel`: vrw | noise_density (velocity random walk: m/s/√h, µg/√Hz), bias_instability,
-//   bias_instability_tau_min/_max, gauss_markov_sigma/_tau, acceleration_random_walk (µg/√s,
-//   (m/s²)/√s ...), turn_on_bias, scale_factor, misalignment, quantization (velocity: mm/s, m/s),
-//   range (acceleration: g, m/s²).
+// Keys of `gyro` and `accel`: the datasheet keys of the sensor-term table (sensor_terms.h,
+// SensorTerm::datasheet_key and datasheet_alt_key: arw | rate_noise_density, bias_instability,
+// bias_instability_tau_min/_max, turn_on_bias, gauss_markov_sigma/_tau, rate_random_walk,
+// scale_factor, misalignment, quantization, range, g_sensitivity; accel: vrw | noise_density,
+// acceleration_random_walk, ... and no g_sensitivity), each setting its term's parameter; a
+// figure must have the term's dimension in any unit the units module knows (docs/calibration.md
+// lists them with examples). A matrix term (g-sensitivity) takes its figure on the diagonal.
 // Every figure is a magnitude (a leading "±", "+-" or "+/-" as printed is accepted); a negative
 // value, an unknown key, a unit of the wrong dimension or a malformed number is a SpecError naming
 // the key path ("gyro.arw"), the text and the allowed units. Unknown keys list the allowed ones.

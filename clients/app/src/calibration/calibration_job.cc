@@ -22,6 +22,7 @@
 #include "driftlab/calib/reference_calibration.h"
 #include "driftlab/calib/static_detection.h"
 #include "driftlab/input_files.h"
+#include "driftlab/sensor_terms.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/units.h"
 #include "job/field_checks.h"
@@ -238,24 +239,140 @@ void AddFit(const calib::CalibrationFit& fit, v1::CalibrationResult* result) {
   for (double rho : fit.correlation) out->add_correlation(rho);
 }
 
-void CheckTable(const NumericTable& table, size_t columns, const std::string& expected) {
-  if (table.columns.size() != columns) {
-    throw SpecError("data",
-                    fmt::format("{} columns ({}); expected {} ({})", table.columns.size(),
-                                Join(table.columns), columns, expected),
-                    0);
+// True when the table came without a header row: its columns are named column1, column2, ...
+// (ReadNumericCsv), so only their positions say what they hold.
+bool WithoutHeader(const NumericTable& table) {
+  for (size_t i = 0; i < table.columns.size(); ++i) {
+    if (table.columns[i] != fmt::format("column{}", i + 1)) return false;
   }
-  if (table.values.size() % columns != 0) {
+  return true;
+}
+
+// The columns `expected` of `table`, in that order: taken by name from a header (in any order;
+// the header must name exactly these columns), or by position from a file without one. Every
+// value must be finite. `units` describes the columns for messages.
+NumericTable SelectColumns(const NumericTable& table, const std::vector<std::string>& expected,
+                           const std::string& units) {
+  const size_t columns = table.columns.size();
+  if (columns == 0 || table.values.size() % columns != 0) {
     throw SpecError("data",
                     fmt::format("{} values is not a whole number of rows of {} columns",
                                 table.values.size(), columns),
                     0);
   }
-  for (size_t i = 0; i < table.values.size(); ++i) {
-    if (!std::isfinite(table.values[i])) {
+  std::vector<size_t> from(expected.size());
+  if (WithoutHeader(table)) {
+    if (columns != expected.size()) {
+      throw SpecError("data",
+                      fmt::format("{} columns without a header; expected {} ({})", columns,
+                                  expected.size(), units),
+                      0);
+    }
+    for (size_t i = 0; i < from.size(); ++i) from[i] = i;
+  } else {
+    std::vector<std::string> missing, extra;
+    for (size_t i = 0; i < expected.size(); ++i) {
+      const auto it = std::find(table.columns.begin(), table.columns.end(), expected[i]);
+      if (it == table.columns.end()) {
+        missing.push_back(expected[i]);
+      } else {
+        from[i] = static_cast<size_t>(it - table.columns.begin());
+      }
+    }
+    for (const std::string& name : table.columns) {
+      if (std::find(expected.begin(), expected.end(), name) == expected.end()) {
+        extra.push_back(name);
+      }
+    }
+    if (!missing.empty() || !extra.empty()) {
       throw SpecError(
-          fmt::format("data: row {} column '{}'", i / columns + 1, table.columns[i % columns]),
-          fmt::format("{}", table.values[i]), "a finite number");
+          "data: header",
+          fmt::format("{}{}{}", Join(table.columns),
+                      missing.empty() ? "" : " (missing " + Join(missing) + ")",
+                      extra.empty() ? "" : " (unknown " + Join(extra) + ")"),
+          fmt::format("a header naming the columns {} ({}), in any order; or no header, the "
+                      "columns in that order",
+                      Join(expected), units));
+    }
+  }
+  NumericTable out;
+  out.columns = expected;
+  out.values.reserve(table.values.size() / columns * expected.size());
+  for (size_t r = 0; r < table.rows(); ++r) {
+    for (size_t i = 0; i < expected.size(); ++i) {
+      const double v = table.values[r * columns + from[i]];
+      if (!std::isfinite(v)) {
+        throw SpecError(fmt::format("data: row {} column '{}'", r + 1, expected[i]),
+                        fmt::format("{}", v), "a finite number");
+      }
+      out.values.push_back(v);
+    }
+  }
+  return out;
+}
+
+// A fitted multi-position parameter outside the sensor model's own ranges (sensor_terms.h: the
+// ranges a job accepts, beyond any real sensor) comes from data the model does not describe:
+// clipped samples, mislabelled columns or other units. Throws SpecError naming the parameter.
+void CheckPlausible(const calib::CalibrationFit& fit) {
+  for (const calib::FitParameter& p : fit.parameters) {
+    const bool gyro = p.name.starts_with("gyro.");
+    const SensorTriad t = gyro ? SensorTriad::kGyro : SensorTriad::kAccel;
+    int field = 0;  // the sensor term whose range applies
+    if (p.name.find(".scale_factor.") != std::string::npos) field = 10;
+    if (p.name.find(".misalignment.") != std::string::npos) field = 13;
+    if (p.name.find(".bias.") != std::string::npos) field = 1;
+    if (field == 0) continue;
+    const SensorTerm& term = *SensorTermByField(field);
+    const double limit = JobValueToSi(term, t, term.max(t), p.name);
+    if (std::abs(p.value) <= limit) continue;
+    throw SpecError(p.name, fmt::format("{} {}", p.value, p.unit),
+                    fmt::format("|{}| <= {} {} ({} {}, the sensor model's range: no sensor has "
+                                "more; the recording may be clipped, its columns mislabelled or "
+                                "not in rad/s and m/s^2)",
+                                p.name, limit, p.unit, term.max(t), JobUnitText(term, t)));
+  }
+}
+
+// Fewest consecutive samples at a column's extreme that count as a flat top.
+constexpr size_t kMinClippedRun = 10;
+
+// Clipping (a saturated sensor) shows as flat tops: runs of samples exactly at a column's largest
+// or smallest value, in a column that is noisy elsewhere (most consecutive samples differ). A
+// noise-free or coarsely quantized recording repeats values everywhere and is not flagged.
+// Throws SpecError naming the column, the level and the samples held there.
+void CheckNotClipped(const NumericTable& table, size_t first_column, const std::string& unit_of) {
+  const size_t columns = table.columns.size(), n = table.rows();
+  if (n < 2 * kMinClippedRun) return;
+  for (size_t c = first_column; c < columns; ++c) {
+    const auto at = [&](size_t r) { return table.values[r * columns + c]; };
+    double lo = at(0), hi = at(0);
+    for (size_t r = 1; r < n; ++r) {
+      lo = std::min(lo, at(r));
+      hi = std::max(hi, at(r));
+    }
+    if (lo == hi) continue;
+    for (const double level : {hi, lo}) {
+      size_t held = 0, longest = 0, run = 0, changes = 0, pairs = 0;
+      for (size_t r = 0; r < n; ++r) {
+        run = at(r) == level ? run + 1 : 0;
+        held += at(r) == level ? 1 : 0;
+        longest = std::max(longest, run);
+        if (r > 0 && at(r) != level && at(r - 1) != level) {
+          ++pairs;
+          changes += at(r) != at(r - 1) ? 1 : 0;
+        }
+      }
+      const bool noisy_elsewhere = pairs > 0 && 2 * changes > pairs;
+      if (longest >= kMinClippedRun && noisy_elsewhere) {
+        throw SpecError(
+            fmt::format("data: column '{}'", table.columns[c]),
+            fmt::format("clipped at {} {}: {} samples sit exactly at the recording's {} (runs of "
+                        "up to {}) while the column is noisy elsewhere",
+                        level, unit_of, held, level == hi ? "maximum" : "minimum", longest),
+            "a recording inside the sensor's range (a saturated sensor gives scale factors and "
+            "biases no sensor has; record the poses within its range)");
+      }
     }
   }
 }
@@ -293,9 +410,10 @@ void CheckSettings(const CalibrateSettings& s) {
   }
 }
 
-void RunReference(const CalibrateSettings& s, const NumericTable& table,
+void RunReference(const CalibrateSettings& s, const NumericTable& data,
                   v1::CalibrationResult* result) {
-  CheckTable(table, 6, "in_x, in_y, in_z, out_x, out_y, out_z");
+  const NumericTable table = SelectColumns(
+      data, {"in_x", "in_y", "in_z", "out_x", "out_y", "out_z"}, "known inputs, raw outputs");
   const size_t n = table.rows();
   const auto at = [&](size_t row, size_t col) { return table.values[row * 6 + col]; };
   if (s.matrix) {
@@ -318,14 +436,16 @@ void RunReference(const CalibrateSettings& s, const NumericTable& table,
   }
 }
 
-void RunMultiPosition(const CalibrateSettings& s, const NumericTable& table,
+void RunMultiPosition(const CalibrateSettings& s, const NumericTable& data,
                       v1::CalibrationResult* result) {
   const bool has_time = s.rate_hz == 0.0;
-  if (has_time) {
-    CheckTable(table, 7, "t_s, gx, gy, gz [rad/s], ax, ay, az [m/s^2]; 6 without t_s with rate_hz");
-  } else {
-    CheckTable(table, 6, "gx, gy, gz [rad/s], ax, ay, az [m/s^2] with rate_hz; 7 with t_s");
-  }
+  std::vector<std::string> names = {"gx", "gy", "gz", "ax", "ay", "az"};
+  if (has_time) names.insert(names.begin(), "t_s");
+  const NumericTable table = SelectColumns(
+      data, names,
+      has_time ? "t_s [s], gyro rates [rad/s], specific forces [m/s^2]; without t_s with rate_hz"
+               : "gyro rates [rad/s], specific forces [m/s^2] with rate_hz; with t_s without it");
+  CheckNotClipped(table, has_time ? 1 : 0, "(rad/s or m/s^2)");
   const size_t columns = table.columns.size(), o = has_time ? 1 : 0;
   calib::RawImuRecording rec;
   const size_t n = table.rows();
@@ -362,10 +482,12 @@ void RunMultiPosition(const CalibrateSettings& s, const NumericTable& table,
   if (s.loss == "huber") ao.loss = calib::RobustLoss::kHuber;
   if (s.loss == "cauchy") ao.loss = calib::RobustLoss::kCauchy;
   const calib::AccelCalibration accel = calib::CalibrateAccelerometers(det.intervals, ao);
+  CheckPlausible(accel.fit);
   if (s.kind != "gyro") AddFit(accel.fit, result);
   if (s.kind != "accel") {
     const calib::GyroCalibration gyro =
         calib::CalibrateGyros(rec, det.intervals, accel, calib::GyroCalibrationOptions{});
+    CheckPlausible(gyro.fit);
     AddFit(gyro.fit, result);
   }
 }

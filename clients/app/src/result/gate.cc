@@ -117,6 +117,18 @@ bool SameRuns(const v1::JobResult& baseline, const v1::JobResult& current) {
          c.runs_size() == static_cast<int>(current.run_count());
 }
 
+// A paired metric whose per-run values are the same in both files: the current population value is
+// the baseline's exactly (the runs share every random number and gave the same errors), so the
+// ratio is 1 with no uncertainty. The t statistics of the paired tests are undefined there (all
+// differences 0 at ratio 1, and a statistic of fixed size at any other ratio).
+TestOutcome Identical(double limit_ratio) {
+  TestOutcome out;
+  out.ratio = out.ratio_low = out.ratio_high = 1.0;
+  out.p_value = limit_ratio >= 1.0 ? 1.0 : 0.0;
+  out.test = "paired: identical per-run values";
+  return out;
+}
+
 // Runs the test of one metric present in both results.
 TestOutcome TestMetric(const v1::JobResult& baseline, const Metric& mb,
                        const v1::JobResult& current, const Metric& mc, double limit_ratio,
@@ -133,6 +145,7 @@ TestOutcome TestMetric(const v1::JobResult& baseline, const Metric& mb,
       none.test = "none: per-run values not kept";
       return none;
     }
+    if (paired && xb == xc) return Identical(limit_ratio);
     // The bootstrap costs B x n per metric; above kMaxBootstrapRuns the order-statistic bounds
     // (valid for paired samples too) are tight enough and far cheaper.
     if (paired && xb.size() == xc.size() && xb.size() >= 3 && xb.size() <= kMaxBootstrapRuns) {
@@ -166,6 +179,7 @@ TestOutcome TestMetric(const v1::JobResult& baseline, const Metric& mb,
     const std::vector<double> y =
         RunValues(current, CheckpointAt(current, t_s), mc.component, false);
     if (x.size() >= 3 && x.size() == y.size()) {
+      if (x == y) return Identical(limit_ratio);
       switch (mb.kind) {
         case MetricKind::kStd:
           return TestSigmaPaired(x, y, limit_ratio, alpha);
@@ -243,6 +257,18 @@ GateReport RunGate(const v1::JobResult& baseline, const v1::JobResult& current,
                    const std::vector<GateRule>& rules, const GateOptions& options) {
   if (!(options.alpha > 0 && options.alpha < 1)) {
     throw SpecError("--alpha", fmt::format("{}", options.alpha), "0 < alpha < 1");
+  }
+  // Every test needs each file's sample standard deviation (moments) or at least two order
+  // statistics (quantiles): one run has neither.
+  for (const auto& [result, name] :
+       {std::pair<const v1::JobResult&, const std::string&>{baseline, options.baseline_name},
+        {current, options.current_name}}) {
+    if (result.run_count() < kMinGateRuns) {
+      throw SpecError(name + ": run_count", std::to_string(result.run_count()),
+                      fmt::format(">= {} runs per gated file (a gate tests each file's spread; "
+                                  "one run has none)",
+                                  kMinGateRuns));
+    }
   }
   GateReport report;
   report.options = options;

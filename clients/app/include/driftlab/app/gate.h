@@ -126,7 +126,13 @@ struct GateOptions {
   double alpha = kDefaultAlpha;  // family-wise error rate over the gated metrics
   bool strict = false;           // inconclusive metrics fail the gate
   bool allow_different_job = false;
+  // How messages name the two results (the CLI passes the file names).
+  std::string baseline_name = "baseline";
+  std::string current_name = "current";
 };
+
+// Fewest runs a gated file may hold.
+inline constexpr uint32_t kMinGateRuns = 2;
 
 struct GateReport {
   std::vector<GateRow> rows;  // in ListMetrics order of the baseline
@@ -146,7 +152,11 @@ struct GateReport {
   bool passed() const { return failures() == 0; }
 };
 
-// Compares `current` against `baseline` under `rules`. The mode is paired when both results have
+// Compares `current` against `baseline` under `rules`. Both results must hold at least
+// kMinGateRuns runs (SpecError naming the file's run_count otherwise) and should have passed
+// VerifyResultStatistics (result_check.h). A paired metric whose per-run values are identical in
+// both files has ratio 1 exactly (interval [1, 1]): a file gated against itself passes. The mode
+// is paired when both results have
 // the same seed and run range and keep per-run values (then they share their random numbers),
 // else independent. Throws SpecError when the two results are of different jobs (their job echoes
 // differ in anything but monte_carlo.runs and monte_carlo.seed) and allow_different_job is false,

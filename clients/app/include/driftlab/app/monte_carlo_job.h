@@ -1,13 +1,6 @@
 // A job's Monte-Carlo side: translation of `monte_carlo` (and of the whole job) into the engine's
-// MonteCarloSpec with validation, and the conversion of the engine's statistics into the result
-// schema (driftlab.v1.JobResult) and back for `driftlab merge`.
-//
-// Units: the engine's statistics are SI with angles in radians; the result file has angles in
-// degrees (API rule). The exact sums of the merge state stay in the engine's units (radians for
-// angles): they are the engine's opaque state, converted only through the engine. Checkpoint
-// per-run values are converted per value, and every checkpoint summary (percentiles, CEP, 2DRMS,
-// maxima) is computed from those converted values in run order, by FillCheckpointSummaries, in
-// both `run` and `merge`: so a merged result equals the single-process one bit for bit.
+// MonteCarloSpec with validation. The conversion of the engine's statistics into the result
+// schema and back (`driftlab merge`) is job_result.h.
 #pragma once
 
 #include <cstdint>
@@ -16,6 +9,7 @@
 #include <vector>
 
 #include "driftlab/app/job_file.h"
+#include "driftlab/app/job_result.h"
 #include "driftlab/mc_statistics.h"
 #include "driftlab/monte_carlo.h"
 #include "driftlab/v1/result.pb.h"
@@ -60,31 +54,5 @@ MonteCarloSpec ToMonteCarloSpec(const JobFile& file, const MonteCarloOverrides& 
 // The job as run: the job file's message with the overrides written into monte_carlo (runs,
 // seed), for the result's echo.
 v1::Job JobAsRun(const v1::Job& job, const MonteCarloSpec& spec);
-
-// The result of a (shard of a) job. `cpu_s` is the process CPU time when measured (< 0: absent).
-// Throws SpecError for a cancelled job or runs that are not one contiguous range.
-v1::JobResult ToJobResult(const v1::Job& job_as_run, const MonteCarloStatistics& statistics,
-                          const std::string& engine_version, double cpu_s = -1.0);
-// The same with the analyses of RunMonteCarloWithAnalysis: `covariance` (predicted sigma per
-// epoch, in the result's units and component order) and `filter_consistency` (average NEES per
-// epoch with its chi-square 95 % bounds; its exact sums go to merge_state for `merge`).
-v1::JobResult ToJobResult(const v1::Job& job_as_run, const MonteCarloOutput& output,
-                          const std::string& engine_version, double cpu_s = -1.0);
-
-// Fills each checkpoint's percentiles, CEP50/95, 2DRMS and maxima from its per-run values.
-void FillCheckpointSummaries(v1::JobResult* result);
-
-// The engine statistics held by a result (epoch sums from the merge state, checkpoint values
-// converted back to radians); throws SpecError naming `source` for a result without a usable
-// merge state.
-MonteCarloStatistics StatisticsFromJobResult(const v1::JobResult& result,
-                                             const std::string& source);
-
-// Merges shards of one job (any order, any grouping) into one result: the same job echo, seed
-// and epochs are required and the runs must be disjoint and together contiguous. `sources` name
-// the inputs in errors. Throws SpecError.
-v1::JobResult MergeJobResults(const std::vector<v1::JobResult>& shards,
-                              const std::vector<std::string>& sources,
-                              const std::string& engine_version);
 
 }  // namespace driftlab::app
