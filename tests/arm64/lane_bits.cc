@@ -5,7 +5,7 @@
 // lane-wise IEEE arithmetic, no contraction).
 // What it runs, at the baseline kernel's width (4 lanes: two SSE2 registers a value on x86-64,
 // two NEON registers on arm64):
-//   * lane_math::Log, SinCos, SinCosNear on a grid of arguments;
+//   * elementary::Log, SinCos, SinCosNear on a grid of arguments;
 //   * the deviates of the lockstep kernels (random_kernels::GaussianAcrossRuns: Philox4x32-10 and
 //     Box-Muller) for 4 runs;
 //   * 40 blocks (5120 samples at 100 Hz) of the lockstep kernel (lockstep_ned_kernel.h): the
@@ -13,7 +13,7 @@
 //     flicker component, range and quantization) on synthetic increments of a turning,
 //     climbing vehicle, then the WGS-84 NED mechanization with coning/sculling;
 //   * the engine's scalar exp, expm1, log, log1p, atan, atan2, asin, acos, hypot and ln Gamma
-//     (lane_math.h, the engine's replacements of the C library's) on grids;
+//     (math/elementary_functions.h, the engine's replacements of the C library's) on grids;
 //   * the statistics' error components of the 4 lanes against a truth (nav_error_lanes.h):
 //     position, velocity, Euler-angle errors and norms (IEEE operations, the engine's atan2,
 //     asin and hypot, and remainder, which is exact in any correct C library).
@@ -24,9 +24,10 @@
 #include <cstring>
 #include <memory>
 
+#include "lanes/lane.h"
 #include "lockstep/lockstep_lanes.h"
 #include "lockstep/lockstep_ned_kernel.h"
-#include "math/lane_math.h"
+#include "math/elementary_functions.h"
 #include "random/random_kernels.h"
 #include "stats/nav_error_lanes.h"
 
@@ -53,20 +54,20 @@ void ElementaryFunctions() {
   Digest log_d, sincos_d, near_d;
   for (int i = 1; i <= 20000; ++i) {
     const double x = 1e-12 * i * i * i;  // 1e-12 .. 8e0
-    log_d.Add(driftlab::lane_math::Log<1>(x));
+    log_d.Add(driftlab::elementary::Log<1>(x));
   }
   for (int i = -20000; i <= 20000; ++i) {
     const double x = 1.37e-3 * i * 3.1;  // about -85 .. 85 rad
     double s, c;
-    driftlab::lane_math::SinCos<1>(x, s, c);
+    driftlab::elementary::SinCos<1>(x, s, c);
     sincos_d.Add(s);
     sincos_d.Add(c);
     double s4[kW], c4[kW];
-    driftlab::lane_math::D<kW> xs = {x, x + 1e-3, x - 2e-3, x + 0.02};
-    driftlab::lane_math::D<kW> x0 = {x, x, x, x};
-    driftlab::lane_math::D<kW> s0 = {s, s, s, s}, c0 = {c, c, c, c};
-    driftlab::lane_math::D<kW> so, co;
-    driftlab::lane_math::SinCosNear<kW>(xs, x0, s0, c0, so, co);
+    driftlab::lanes::D<kW> xs = {x, x + 1e-3, x - 2e-3, x + 0.02};
+    driftlab::lanes::D<kW> x0 = {x, x, x, x};
+    driftlab::lanes::D<kW> s0 = {s, s, s, s}, c0 = {c, c, c, c};
+    driftlab::lanes::D<kW> so, co;
+    driftlab::elementary::SinCosNear<kW>(xs, x0, s0, c0, so, co);
     std::memcpy(s4, &so, sizeof(s4));
     std::memcpy(c4, &co, sizeof(c4));
     for (int l = 0; l < kW; ++l) {
@@ -74,15 +75,15 @@ void ElementaryFunctions() {
       near_d.Add(c4[l]);
     }
   }
-  Print("lane_math_log", log_d);
-  Print("lane_math_sincos", sincos_d);
-  Print("lane_math_sincos_near", near_d);
+  Print("elementary_log", log_d);
+  Print("elementary_sincos", sincos_d);
+  Print("elementary_sincos_near", near_d);
   // The scalar functions the engine uses instead of the C library's (driftlab/elementary.h).
   Digest scalar;
   for (int i = -30000; i <= 30000; ++i) {
     const double x = 1.2345e-3 * i + 1e-7;  // about -37 .. 37
     const double t = x / 37.1;              // within (-1, 1)
-    using namespace driftlab::lane_math;
+    using namespace driftlab::elementary;
     scalar.Add(Exp(x * 19.0));
     scalar.Add(Expm1(t));
     scalar.Add(Ln(x * x + 1e-300));
@@ -145,7 +146,7 @@ driftlab::TriadStepParams Triad(double scale) {
 }
 
 void KernelAndErrors() {
-  using driftlab::lane_math::SinCos;
+  using driftlab::elementary::SinCos;
   constexpr double kDt = 0.01;
   constexpr int kBlocks = 40;
   constexpr int64_t kSamples = int64_t{kBlocks} * kBlock;

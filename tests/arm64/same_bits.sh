@@ -2,7 +2,7 @@
 # The engine on arm64 (the default build runs on any x86-64 and builds on arm64; every path gives
 # the same bits), with Debian's cross compiler and qemu-user (scripts/ci-packages.sh
 # installs g++-aarch64-linux-gnu and qemu-user-static; without them this exits 77, skipped):
-#  1. tests/arm64/lane_bits.cc (the lane code: lane_math, the deviates, the lockstep kernel's
+#  1. tests/arm64/lane_bits.cc (the lane code: the elementary functions, the deviates, the lockstep kernel's
 #     sensor and mechanization steps, the statistics' error components) built for this machine and
 #     for arm64 with the engine's options (-ffp-contract=off; the kernel files' -fno-math-errno
 #     -fvect-cost-model=dynamic), the arm64 one run under qemu: both print the same digests, line

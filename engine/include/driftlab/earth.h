@@ -100,7 +100,7 @@ class NavEnvironment {
   Vector3d TransportRate(double L_b, double h_b, const Vector3d& v_eb_n) const;  // omega_en_n
   // A latitude with its sine and cosine, for code that evaluates the Earth model at several
   // nearby latitudes (the trajectory generator's sub-step): Near() takes them from a known one by
-  // the angle-sum rotation (lane_math::SinCosNear, within ~2 ulp of a full sin/cos).
+  // the angle-sum rotation (elementary::SinCosNear, within ~2 ulp of a full sin/cos).
   struct Latitude {
     double L_rad = 0.0, sin_L = 0.0, cos_L = 1.0;
     static Latitude Of(double L_rad);

@@ -1,7 +1,7 @@
-// The engine's own elementary functions (engine/src/math/lane_math.h), for every result the engine
-// computes: the C library's exp, log, log1p, sin, cos, tan, atan, atan2, asin, acos, expm1, lgamma
-// and hypot round differently on different machines (glibc's FMA and SSE2 variants on x86-64,
-// arm64's), and DESIGN.md "Same bits everywhere" asks for one answer everywhere. IEEE basic
+// The engine's own elementary functions (engine/src/math/elementary_functions.h), for every result
+// the engine computes: the C library's exp, log, log1p, sin, cos, tan, atan, atan2, asin, acos,
+// expm1, lgamma and hypot round differently on different machines (glibc's FMA and SSE2 variants on
+// x86-64, arm64's), and DESIGN.md "Same bits everywhere" asks for one answer everywhere. IEEE basic
 // operations only: the same bits on every machine; within a few ulp of the exact values
 // (elementary_test.cc).
 #pragma once

@@ -25,9 +25,9 @@
 // 2.6e-11 |z| + 7.1e-12 r of the exact transform of its two words (r = sqrt(-2 ln u1)), a twelfth
 // of the input's own step; tests/engine/random/random_test.cc checks it.
 // Vectorisation: deviates are produced in chunks of 32 Philox blocks (SoA). The Box-Muller code
-// (engine/src/math/lane_math.h) has no branches, comparisons or conversion instructions, so GCC
-// vectorises it on every x86-64 level (baseline, AVX2, AVX-512); Philox runs 4 blocks per AVX2
-// vector with VPMULUDQ where GCC leaves it scalar. The lockstep kernels draw the same deviates
+// (engine/src/math/elementary_functions.h) has no branches, comparisons or conversion instructions,
+// so GCC vectorises it on every x86-64 level (baseline, AVX2, AVX-512); Philox runs 4 blocks per
+// AVX2 vector with VPMULUDQ where GCC leaves it scalar. The lockstep kernels draw the same deviates
 // across the runs of a group instead (random_kernels.h GaussianAcrossRuns: one vector lane per
 // run, the same block index). All operations are IEEE basic ones or integer: the same bits on
 // every path.
@@ -121,16 +121,16 @@ class RandomStream {
 // The engine's own elementary functions for the Gaussian transform (exposed for tests).
 // Natural logarithm of x in [2^-1022, 2^1024): exponent/mantissa split, then
 // ln m = 2 atanh(s), s = (m - 1)/(m + 1), Taylor series to s^11 (|s| <= 0.172: within 5.2e-11
-// relative; engine/src/math/lane_math.h says why that is enough for 32-bit uniforms).
+// relative; engine/src/math/elementary_functions.h says why that is enough for 32-bit uniforms).
 double PolyLog(double x);
 // sin(2 pi u) and cos(2 pi u) for u = x 2^-32 in [0, 1): reduced exactly (integer arithmetic) to
 // a quadrant and theta in [-pi/4, pi/4], Taylor series to theta^11 (sin) and theta^12 (cos)
 // (within 7.1e-12), then rotated by the quadrant.
 void PolySinCosTwoPi(uint32_t x, double* sin_out, double* cos_out);
 // sin x and cos x as the navigation code computes them (earth.cc, attitude.cc and the lockstep
-// kernels, engine/src/math/lane_math.h): n = round(2x/pi), t = x - n pi/2 by Cody-Waite with pi/2
-// in three 33-bit pieces (exact for |x| < 1.6e6 rad), the same Taylor series on t, rotated by n
-// mod 4.
+// kernels, engine/src/math/elementary_functions.h): n = round(2x/pi), t = x - n pi/2 by Cody-Waite
+// with pi/2 in three 33-bit pieces (exact for |x| < 1.6e6 rad), the same Taylor series on t,
+// rotated by n mod 4.
 void PolySinCos(double x, double* sin_out, double* cos_out);
 
 }  // namespace driftlab

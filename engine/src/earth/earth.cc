@@ -3,17 +3,18 @@
 #include <cmath>
 
 #include "driftlab/elementary.h"
-#include "math/lane_math.h"
+#include "math/elementary_functions.h"
 #include "stats/nav_error_lanes.h"
 
 namespace driftlab {
 
 namespace {
 
-// The engine's own sin and cos (lane_math.h): the lockstep kernels compute the same bits.
+// The engine's own sin and cos (math/elementary_functions.h): the lockstep kernels compute the same
+// bits.
 struct SinCosOf {
   double s, c;
-  explicit SinCosOf(double x) { lane_math::SinCos<1>(x, s, c); }
+  explicit SinCosOf(double x) { elementary::SinCos<1>(x, s, c); }
   explicit SinCosOf(const NavEnvironment::Latitude& L) : s(L.sin_L), c(L.cos_L) {}
 };
 double Sin(double x) { return SinCosOf(x).s; }
@@ -200,14 +201,14 @@ Vector3d NavEnvironment::TransportRate(double L_b, double h_b, const Vector3d& v
 NavEnvironment::Latitude NavEnvironment::Latitude::Of(double L_rad) {
   Latitude l;
   l.L_rad = L_rad;
-  lane_math::SinCos<1>(L_rad, l.sin_L, l.cos_L);
+  elementary::SinCos<1>(L_rad, l.sin_L, l.cos_L);
   return l;
 }
 
 NavEnvironment::Latitude NavEnvironment::Latitude::Near(const Latitude& known, double L_rad) {
   Latitude l;
   l.L_rad = L_rad;
-  lane_math::SinCosNear<1>(L_rad, known.L_rad, known.sin_L, known.cos_L, l.sin_L, l.cos_L);
+  elementary::SinCosNear<1>(L_rad, known.L_rad, known.sin_L, known.cos_L, l.sin_L, l.cos_L);
   return l;
 }
 

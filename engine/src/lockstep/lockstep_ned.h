@@ -14,7 +14,7 @@
 // Same bits as the scalar code: the kernel performs, lane by lane, the same IEEE operations in
 // the same order as ImuErrorSimulator::Apply (sensors.cc) and NedMechanization::Update (ins.cc,
 // with Eigen 3.4's operation order for quaternion products, rotation of vectors and norms), sin
-// and cos being the engine's own (lane_math.h), as in the scalar earth.cc and attitude.cc;
+// and cos being the engine's own (math/elementary_functions.h), as in the scalar earth.cc and attitude.cc;
 // -ffp-contract=off everywhere. Deviates come from the same RandomStream keys and
 // indices. So a run's result is the same whichever lane, group, thread, shard or instruction set
 // computes it, and equal to the scalar RunNed's (lockstep_ned_test.cc checks all of this).

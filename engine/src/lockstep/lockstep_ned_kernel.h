@@ -15,14 +15,15 @@
 // halves the range), the quaternion product as its SSE2/NEON kernel (Geometry_SIMD.h), q * v as
 // _transformVector, normalized() as division by sqrt of (x^2 + z^2) + (y^2 + w^2) (two-lane
 // packets).
-// sin and cos are the engine's own (lane_math.h, also used by the scalar earth.cc and attitude.cc),
-// computed for all W lanes at once; tan L is sin L / cos L in both.
+// sin and cos are the engine's own (math/elementary_functions.h, also used by the scalar earth.cc
+// and attitude.cc), computed for all W lanes at once; tan L is sin L / cos L in both.
 #pragma once
 
 #include <cstdint>
 
+#include "lanes/lane.h"
 #include "lockstep/lockstep_lanes.h"
-#include "math/lane_math.h"
+#include "math/elementary_functions.h"
 #include "random/random_kernels.h"
 #include "stats/nav_error_lanes.h"
 
@@ -31,8 +32,8 @@ namespace {
 
 template <int W>
 struct Kernel {
-  using P = lane_math::D<W>;
-  using U = lane_math::U<W>;
+  using P = lanes::D<W>;
+  using U = lanes::U<W>;
 
   struct V3 {
     P x, y, z;
@@ -59,7 +60,7 @@ struct Kernel {
   }
   static V3 Splat3(double x, double y, double z) { return {Splat(x), Splat(y), Splat(z)}; }
 
-  static P Sqrt(P x) { return lane_math::Sqrt<W>(x); }
+  static P Sqrt(P x) { return lanes::Sqrt<W>(x); }
   // All-ones lanes where the comparison holds.
   static U Mask(decltype(P{} < P{}) m) {
     if constexpr (W == 1) {
@@ -122,9 +123,8 @@ struct Kernel {
     const P n2 = (q.x * q.x + q.z * q.z) + (q.y * q.y + q.w * q.w);
     const P n = Sqrt(n2);
     const U positive = Mask(n2 > 0.0);
-    return {
-        lane_math::Select<W>(positive, q.w / n, q.w), lane_math::Select<W>(positive, q.x / n, q.x),
-        lane_math::Select<W>(positive, q.y / n, q.y), lane_math::Select<W>(positive, q.z / n, q.z)};
+    return {lanes::Select<W>(positive, q.w / n, q.w), lanes::Select<W>(positive, q.x / n, q.x),
+            lanes::Select<W>(positive, q.y / n, q.y), lanes::Select<W>(positive, q.z / n, q.z)};
   }
   // RotationVectorToQuaternion (attitude.cc): both of its branches for every lane, then the one
   // each lane's angle takes. Inlined, as Propagate: GCC otherwise calls them with their vector
@@ -136,13 +136,12 @@ struct Kernel {
     // The Earth-rate rotation (~1e-6 rad a step) and a slowly turning body take the series in
     // every lane: sin and cos are then skipped (their lanes would not be selected).
     bool any_large = false;
-    for (int i = 0; i < W; ++i) any_large = any_large || lane_math::GetLane<W>(small, i) == 0;
+    for (int i = 0; i < W; ++i) any_large = any_large || lanes::GetLane<W>(small, i) == 0;
     P sin_half = Splat(0.0), cos_half = Splat(1.0);
-    if (any_large) lane_math::SinCos<W>(0.5 * a, sin_half, cos_half);
-    const P w =
-        lane_math::Select<W>(small, 1.0 - a2 * (1.0 / 8.0) + a2 * a2 * (1.0 / 384.0), cos_half);
-    const P k = lane_math::Select<W>(small, 0.5 - a2 * (1.0 / 48.0) + a2 * a2 * (1.0 / 3840.0),
-                                     sin_half / a);
+    if (any_large) elementary::SinCos<W>(0.5 * a, sin_half, cos_half);
+    const P w = lanes::Select<W>(small, 1.0 - a2 * (1.0 / 8.0) + a2 * a2 * (1.0 / 384.0), cos_half);
+    const P k =
+        lanes::Select<W>(small, 0.5 - a2 * (1.0 / 48.0) + a2 * a2 * (1.0 / 3840.0), sin_half / a);
     return {w, k * rho.x, k * rho.y, k * rho.z};
   }
 
@@ -166,15 +165,15 @@ struct Kernel {
   };
   static Lat LatOf(P L) {
     P s, c;
-    lane_math::SinCos<W>(L, s, c);
+    elementary::SinCos<W>(L, s, c);
     return LatOfSinCos(L, s, c);
   }
   // The Lat of a latitude L near one already known (the step's midpoint and end from its start;
-  // |L - base.L| ~ v dt / R, 5e-7 rad for 300 m/s at 100 Hz) by lane_math::SinCosNear, so that
+  // |L - base.L| ~ v dt / R, 5e-7 rad for 300 m/s at 100 Hz) by elementary::SinCosNear, so that
   // the step needs one full sin/cos of latitude instead of five.
   static Lat LatNear(const Lat& base, P L) {
     P s, c;
-    lane_math::SinCosNear<W>(L, base.L, base.s, base.c, s, c);
+    elementary::SinCosNear<W>(L, base.L, base.s, base.c, s, c);
     return LatOfSinCos(L, s, c);
   }
   static Lat LatOfSinCos(P L, P s, P c) {
@@ -272,12 +271,12 @@ struct Kernel {
       P v = y + e;
       if (p.range > 0.0) {
         const double lo = -p.range * weight, hi = p.range * weight;
-        v = lane_math::Clamp<W>(v, lo, hi);
+        v = lanes::Clamp<W>(v, lo, hi);
       }
       if (p.quantization > 0.0) {
         const double lsb = p.quantization;
         const P carried = v + Get(t.remainder[i]);
-        const P q = lane_math::Floor<W>(carried / lsb + 0.5);
+        const P q = lanes::Floor<W>(carried / lsb + 0.5);
         const P o = lsb * q;
         Put(t.remainder[i], carried - o);
         v = o;

@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "driftlab/elementary.h"
-#include "math/lane_math.h"
+#include "math/elementary_functions.h"
 #include "stats/nav_error_lanes.h"
 
 namespace driftlab {
@@ -55,7 +55,7 @@ Matrix3d RotationVectorToDcm(const Vector3d& rho) {
     c = 0.5 - a2 / 24.0 + a2 * a2 / 720.0;
   } else {
     double sin_a, cos_a;
-    lane_math::SinCos<1>(a, sin_a, cos_a);
+    elementary::SinCos<1>(a, sin_a, cos_a);
     s = sin_a / a;
     c = (1.0 - cos_a) / a2;
   }
@@ -72,8 +72,9 @@ Quaterniond RotationVectorToQuaternion(const Vector3d& rho) {
     w = 1.0 - a2 * (1.0 / 8.0) + a2 * a2 * (1.0 / 384.0);
     k = 0.5 - a2 * (1.0 / 48.0) + a2 * a2 * (1.0 / 3840.0);
   } else {
-    double sin_half, cos_half;  // the engine's own (lane_math.h), as the lockstep kernels
-    lane_math::SinCos<1>(0.5 * a, sin_half, cos_half);
+    double sin_half,
+        cos_half;  // the engine's own (math/elementary_functions.h), as the lockstep kernels
+    elementary::SinCos<1>(0.5 * a, sin_half, cos_half);
     w = cos_half;
     k = sin_half / a;
   }

@@ -1,7 +1,7 @@
 // Philox4x32-10 and the Box-Muller transform with the engine's own ln, sin, cos (random.h).
 #include "driftlab/random.h"
 
-#include "math/lane_math.h"
+#include "math/elementary_functions.h"
 #include "random/random_kernels.h"
 
 namespace driftlab {
@@ -52,7 +52,7 @@ void PolySinCosTwoPi(uint32_t x, double* sin_out, double* cos_out) {
 }
 
 void PolySinCos(double x, double* sin_out, double* cos_out) {
-  lane_math::SinCos<1>(x, *sin_out, *cos_out);
+  elementary::SinCos<1>(x, *sin_out, *cos_out);
 }
 
 }  // namespace driftlab

@@ -9,7 +9,8 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "math/lane_math.h"
+#include "lanes/lane.h"
+#include "math/elementary_functions.h"
 
 #if defined(__SSE2__)
 #include <immintrin.h>
@@ -57,10 +58,10 @@ inline void Philox10(uint32_t& c0, uint32_t& c1, uint32_t& c2, uint32_t& c3, uin
   }
 }
 
-inline double LogInline(double x) { return lane_math::Log<1>(x); }
+inline double LogInline(double x) { return elementary::Log<1>(x); }
 
 inline void SinCosTwoPiInline(uint32_t x, double& sin_out, double& cos_out) {
-  lane_math::SinCosTwoPi<1>(x, sin_out, cos_out);
+  elementary::SinCosTwoPi<1>(x, sin_out, cos_out);
 }
 
 // Deviates of blocks [block0, block0 + nblocks) in index order (4 per block) into out.
@@ -79,34 +80,34 @@ constexpr int kPhiloxLanes = 1;
 // multiplies the low 32 bits of each 64-bit lane (VPMULUDQ). Integer arithmetic: exact, the
 // same on every path.
 template <int W>
-inline lane_math::U<W> MulLow32(lane_math::U<W> a, uint32_t m) {
+inline lanes::U<W> MulLow32(lanes::U<W> a, uint32_t m) {
 #if defined(__AVX512F__)
   if constexpr (W == 8) {
     // GCC 12's _mm512_mul_epu32 passes an undefined merge operand that -Wmaybe-uninitialized
     // reports; the instruction does not read it.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-    return reinterpret_cast<lane_math::U<W>>(
+    return reinterpret_cast<lanes::U<W>>(
         _mm512_mul_epu32(reinterpret_cast<__m512i>(a), _mm512_set1_epi64(m)));
 #pragma GCC diagnostic pop
   }
 #endif
 #if defined(__AVX2__)
   if constexpr (W == 4) {
-    return reinterpret_cast<lane_math::U<W>>(
+    return reinterpret_cast<lanes::U<W>>(
         _mm256_mul_epu32(reinterpret_cast<__m256i>(a), _mm256_set1_epi64x(m)));
   }
 #endif
 #if defined(__SSE2__)
   if constexpr (W == 2) {
-    return reinterpret_cast<lane_math::U<W>>(
+    return reinterpret_cast<lanes::U<W>>(
         _mm_mul_epu32(reinterpret_cast<__m128i>(a), _mm_set1_epi64x(m)));
   } else if constexpr (W > 2) {  // the two halves, each by the widest instruction above
-    lane_math::U<W / 2> half[2];
+    lanes::U<W / 2> half[2];
     __builtin_memcpy(half, &a, sizeof(a));
     half[0] = MulLow32<W / 2>(half[0], m);
     half[1] = MulLow32<W / 2>(half[1], m);
-    lane_math::U<W> r;
+    lanes::U<W> r;
     __builtin_memcpy(&r, half, sizeof(r));
     return r;
   }
@@ -117,9 +118,9 @@ inline lane_math::U<W> MulLow32(lane_math::U<W> a, uint32_t m) {
 // The ten Philox rounds of Philox10 above on W counters at once, in 64-bit lanes holding 32-bit
 // words.
 template <int W>
-inline void PhiloxRoundsLanes(const uint32_t* key, lane_math::U<W>& c0, lane_math::U<W>& c1,
-                              lane_math::U<W>& c2, lane_math::U<W>& c3) {
-  using lane_math::U;
+inline void PhiloxRoundsLanes(const uint32_t* key, lanes::U<W>& c0, lanes::U<W>& c1,
+                              lanes::U<W>& c2, lanes::U<W>& c3) {
+  using lanes::U;
   uint32_t k0 = key[0], k1 = key[1];
 #pragma GCC unroll 10
   for (int round = 0; round < 10; ++round) {  // kPhiloxRounds (random.h)
@@ -141,7 +142,7 @@ inline void PhiloxRoundsLanes(const uint32_t* key, lane_math::U<W>& c0, lane_mat
 template <int W>
 inline void PhiloxLanes(const uint32_t* key, uint32_t run_word, uint32_t stream_word,
                         uint64_t block, uint32_t (&x)[4][kChunkBlocks], int b) {
-  using lane_math::U;
+  using lanes::U;
   U<W> blocks;
   if constexpr (W == 1) {
     blocks = block;
@@ -197,15 +198,16 @@ inline void GaussianChunk(const uint32_t* key, uint32_t run_word, uint32_t strea
   PhiloxChunk(key, run_word, stream_word, block0, nblocks, x);
   // Box-Muller on the pairs (x0, x1) -> deviates 0, 1 and (x2, x3) -> deviates 2, 3 of a block:
   // z = sqrt(-2 ln u1) (cos, sin)(2 pi u2), u1 = (x0 + 1) 2^-32 in (0, 1], u2 = x1 2^-32.
-  // Branch-free scalar code (lane_math.h, W = 1) that the compiler vectorises across blocks.
+  // Branch-free scalar code (math/elementary_functions.h, W = 1) that the compiler vectorises
+  // across blocks.
   for (int pair = 0; pair < 2; ++pair) {
     const uint32_t* xr = x[2 * pair];
     const uint32_t* xa = x[2 * pair + 1];
     for (int b = 0; b < nblocks; ++b) {
-      const double u1 = (lane_math::ToDouble<1>(xr[b]) + 1.0) * kTwoPowMinus32;
-      const double radius = __builtin_sqrt(-2.0 * lane_math::Log<1>(u1));
+      const double u1 = (lanes::ToDouble<1>(xr[b]) + 1.0) * kTwoPowMinus32;
+      const double radius = __builtin_sqrt(-2.0 * elementary::Log<1>(u1));
       double s, c;
-      lane_math::SinCosTwoPi<1>(xa[b], s, c);
+      elementary::SinCosTwoPi<1>(xa[b], s, c);
       out[4 * b + 2 * pair] = radius * c;
       out[4 * b + 2 * pair + 1] = radius * s;
     }
@@ -233,8 +235,8 @@ inline void UniformChunk(const uint32_t* key, uint32_t run_word, uint32_t stream
 template <int W, int kLanes, int kRowStride>
 inline void GaussianAcrossRuns(const uint32_t* key, const uint32_t* run_words, uint32_t stream_word,
                                uint64_t block0, int nblocks, double* out) {
-  using lane_math::D;
-  using lane_math::U;
+  using lanes::D;
+  using lanes::U;
   static_assert(kLanes % W == 0, "whole vectors of lanes");
   constexpr int kG = kLanes / W;
   U<W> run[kG];
@@ -271,10 +273,10 @@ inline void GaussianAcrossRuns(const uint32_t* key, const uint32_t* run_words, u
         double* row = out + static_cast<size_t>(4 * (b0 + b)) * kRowStride + g * W;
 #pragma GCC unroll 2
         for (int pair = 0; pair < 2; ++pair) {
-          const D<W> u1 = (lane_math::ToDouble<W>(words[b][g][2 * pair]) + 1.0) * kTwoPowMinus32;
-          const D<W> radius = lane_math::Sqrt<W>(-2.0 * lane_math::Log<W>(u1));
+          const D<W> u1 = (lanes::ToDouble<W>(words[b][g][2 * pair]) + 1.0) * kTwoPowMinus32;
+          const D<W> radius = lanes::Sqrt<W>(-2.0 * elementary::Log<W>(u1));
           D<W> s, c;
-          lane_math::SinCosTwoPi<W>(words[b][g][2 * pair + 1], s, c);
+          elementary::SinCosTwoPi<W>(words[b][g][2 * pair + 1], s, c);
           const D<W> z0 = radius * c, z1 = radius * s;
           __builtin_memcpy(row + (2 * pair) * kRowStride, &z0, sizeof(z0));
           __builtin_memcpy(row + (2 * pair + 1) * kRowStride, &z1, sizeof(z1));

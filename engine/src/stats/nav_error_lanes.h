@@ -1,19 +1,20 @@
 // The navigation errors that go into the Monte-Carlo statistics (ErrorComponentsOf,
 // mc_statistics.h: position, velocity and Euler-angle errors, horizontal and 3-D position error),
-// written once over a lane type (lane_math.h): W = 1 is the scalar code (earth.cc's
+// written once over a lane type (lanes/lane.h): W = 1 is the scalar code (earth.cc's
 // PositionErrorNed, attitude.cc's DcmToEuler and WrapPi, mc_statistics.cc's ErrorComponentsOf),
 // W > 1 the errors of a lockstep group's W runs against one truth at once (the lane kernels,
 // lockstep_ned_{baseline,avx2,avx512}.cc), so each operation exists once and every path gives
 // the same bits.
 // Arithmetic is lane-wise IEEE (-ffp-contract=off); atan2, asin and hypot are the engine's own
-// (lane_math.h: the same bits on every machine), remainder the C library's (an exact operation,
-// the same in every correct implementation), called per lane with the same arguments as the
-// scalar code (lanes whose remainder would return its argument unchanged skip the call). As
-// lane_math.h: internal linkage, no Eigen and no standard-library templates (a kernel file shares
-// no inline code with the rest).
+// (math/elementary_functions.h: the same bits on every machine), remainder the C library's (an
+// exact operation, the same in every correct implementation), called per lane with the same
+// arguments as the scalar code (lanes whose remainder would return its argument unchanged skip the
+// call). As lanes/lane.h: internal linkage, no Eigen and no standard-library templates (a kernel
+// file shares no inline code with the rest).
 #pragma once
 
-#include "math/lane_math.h"
+#include "lanes/lane.h"
+#include "math/elementary_functions.h"
 
 namespace driftlab::nav_error_lanes {
 
@@ -28,7 +29,7 @@ struct TruthTerms {
 
 namespace {
 
-using lane_math::D;
+using lanes::D;
 
 constexpr double kPi = 3.14159265358979323846;  // M_PI
 constexpr int kComponents = 11;                 // kNumErrorComponents (mc_statistics.h)
@@ -88,10 +89,10 @@ inline void PositionError(D<W> lat, D<W> lon, D<W> h, double truth_lat, double t
 // (Groves (2.17): the inverse of the Euler-to-DCM (2.22), pitch from the clamped (2,0)).
 template <int W>
 inline void EulerOfDcm(D<W> c00, D<W> c10, D<W> c20, D<W> c21, D<W> c22, D<W> (&euler)[3]) {
-  euler[0] = PerLane<W>(c21, c22, [](double y, double x) { return lane_math::Atan2(y, x); });
+  euler[0] = PerLane<W>(c21, c22, [](double y, double x) { return elementary::Atan2(y, x); });
   euler[1] =
-      -PerLane<W>(lane_math::Clamp<W>(c20, -1.0, 1.0), [](double s) { return lane_math::Asin(s); });
-  euler[2] = PerLane<W>(c10, c00, [](double y, double x) { return lane_math::Atan2(y, x); });
+      -PerLane<W>(lanes::Clamp<W>(c20, -1.0, 1.0), [](double s) { return elementary::Asin(s); });
+  euler[2] = PerLane<W>(c10, c00, [](double y, double x) { return elementary::Atan2(y, x); });
 }
 
 // Those five elements of C_b_n from the quaternion q_b_n = (w, x, y, z), with the operations of
@@ -109,11 +110,11 @@ inline void EulerOfQuaternion(D<W> w, D<W> x, D<W> y, D<W> z, D<W> (&euler)[3]) 
 // x86-64 / arm64 build: sqrt of (x^2 + y^2) + z^2, its two-lane packet reduced first).
 template <int W>
 inline D<W> Horizontal(D<W> n, D<W> e) {
-  return PerLane<W>(n, e, [](double a, double b) { return lane_math::Hypot(a, b); });
+  return PerLane<W>(n, e, [](double a, double b) { return elementary::Hypot(a, b); });
 }
 template <int W>
 inline D<W> Norm3(D<W> x, D<W> y, D<W> z) {
-  return lane_math::Sqrt<W>((x * x + y * y) + z * z);
+  return lanes::Sqrt<W>((x * x + y * y) + z * z);
 }
 
 // ErrorComponentsOf(ComputeNavError(env, estimate, truth)) for W estimates: out[c] is component c

@@ -1,8 +1,9 @@
-// The engine's own elementary functions (driftlab/elementary.h, engine/src/math/lane_math.h)
-// against long double references (x87: 64-bit significands, within ~1 ulp of long double, i.e.
-// 2^-11 of a double ulp) and C's special values. Tolerances in units in the last place of the
-// double result (ulp = 2^(floor(log2 |ref|) - 52)), from the error analysis of each function (the
-// series' truncation is far below 1 ulp; what remains is the rounding of the basic operations):
+// The engine's own elementary functions (driftlab/elementary.h,
+// engine/src/math/elementary_functions.h) against long double references (x87: 64-bit significands,
+// within ~1 ulp of long double, i.e. 2^-11 of a double ulp) and C's special values. Tolerances in
+// units in the last place of the double result (ulp = 2^(floor(log2 |ref|) - 52)), from the error
+// analysis of each function (the series' truncation is far below 1 ulp; what remains is the
+// rounding of the basic operations):
 //   Exp: reduction r (exact n ln2_hi, one rounding of n ln2_lo) + Horner series + 1 + em1 + one
 //        scaling: <= 1 ulp; bound 1.5.
 //   Expm1: the series alone <= 1 ulp; beyond |x| > ln2/2 Exp(x) - 1 multiplies Exp's error by

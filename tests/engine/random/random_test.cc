@@ -32,10 +32,10 @@ TEST(PhiloxTest, MatchesRandom123KnownAnswerVectors) {
 }
 
 TEST(PolynomialMathTest, LogMatchesLongDoubleWithinItsSeriesBound) {
-  // The series stops at s^11 (lane_math.h): the omitted 2 s^13/13 (1 + s^2 + ...) is at most
-  // 5.2e-11 of ln m (|s| <= 0.1716), and at most 1.8e-11 absolute, i.e. below 5.2e-11 |ln x| for
-  // every x (|ln x| >= ln 2 / 2 when the exponent is not 0); rounding adds ~2 ulp.
-  // Over the 32-bit uniforms the Box-Muller uses, and at the ends of the double range.
+  // The series stops at s^11 (math/elementary_functions.h): the omitted 2 s^13/13 (1 + s^2 + ...)
+  // is at most 5.2e-11 of ln m (|s| <= 0.1716), and at most 1.8e-11 absolute, i.e. below 5.2e-11
+  // |ln x| for every x (|ln x| >= ln 2 / 2 when the exponent is not 0); rounding adds ~2 ulp. Over
+  // the 32-bit uniforms the Box-Muller uses, and at the ends of the double range.
   double worst = 0.0;
   for (uint64_t i = 1; i <= (uint64_t{1} << 32); i += 65537) {
     const double x = static_cast<double>(i) / 4294967296.0;
@@ -54,10 +54,10 @@ TEST(PolynomialMathTest, LogMatchesLongDoubleWithinItsSeriesBound) {
 }
 
 TEST(PolynomialMathTest, SinCosOfTwoPiUMatchLongDoubleWithinTheirSeriesBound) {
-  // The Box-Muller angle's series (lane_math.h Series::kGaussian) stop at theta^11 (sin) and
-  // theta^12 (cos): omitted terms <= (pi/4)^13/13! = 7.0e-12 and (pi/4)^14/14! = 4.0e-13 for
-  // |theta| <= pi/4, plus a few 1e-17 of rounding: 7.1e-12 absolute. Adjacent inputs are
-  // 2 pi 2^-32 = 1.5e-9 rad apart.
+  // The Box-Muller angle's series (math/elementary_functions.h, Series::kGaussian) stop at theta^11
+  // (sin) and theta^12 (cos): omitted terms <= (pi/4)^13/13! = 7.0e-12 and (pi/4)^14/14! = 4.0e-13
+  // for |theta| <= pi/4, plus a few 1e-17 of rounding: 7.1e-12 absolute. Adjacent inputs are 2 pi
+  // 2^-32 = 1.5e-9 rad apart.
   const long double two_pi = 2.0L * std::numbers::pi_v<long double>;
   double max_error = 0.0;
   for (uint64_t i = 0; i < (uint64_t{1} << 32); i += 40009) {  // includes the top quadrant

@@ -1,112 +1,32 @@
-// The engine's own elementary functions (DESIGN.md "Same bits everywhere"), written once over a
-// lane type: W = 1 is plain double / uint64_t (the scalar code: random.cc, earth.cc,
-// attitude.cc), W > 1 a GCC vector of W doubles / W uint64_t (the lockstep kernels, one copy per
-// instruction set). Only IEEE basic operations (+, -, *, /, sqrt: correctly rounded per lane) and
-// integer bit operations; no branches, no comparisons, no conversion instructions (integers become
-// doubles by the 2^52 magic-number trick, exactly), so every W and every instruction set gives the
-// same bits, and the code vectorises on every x86-64 level (SSE2 and AVX2 have no unsigned or
-// 64-bit integer -> double conversion). Files including this header are built with
-// -ffp-contract=off (as the whole engine), so no multiply-add is fused.
-// Internal linkage and no standard-library templates: an inline function of an AVX-512 file must
-// not be shared with baseline code by the linker (lockstep_lanes.h).
+// The engine's own elementary functions (DESIGN.md "Same bits everywhere"): ln, sin and cos written
+// over the lane width W (lanes/lane.h: W = 1 is the scalar code, e.g. random.cc, earth.cc,
+// attitude.cc; W > 1 the lockstep kernels, one copy per instruction set), and the scalar exp,
+// expm1, ln, log1p, sin/cos, atan, atan2, asin, acos, hypot and ln Gamma behind
+// driftlab/elementary.h. Only IEEE basic operations (+, -, *, /, sqrt: correctly rounded per lane)
+// and integer bit operations; the lane functions have no branches, no comparisons and no conversion
+// instructions (integers become doubles by the 2^52 magic-number trick, exactly), so every W and
+// every instruction set gives the same bits, and the code vectorises on every x86-64 level.
+// Files including this header are built with -ffp-contract=off (as the whole engine), so no
+// multiply-add is fused. A lane header (lanes/lane.h): internal linkage, no standard-library
+// templates.
 #pragma once
 
 #include <cstdint>
 
-namespace driftlab::lane_math {
+#include "lanes/lane.h"
+
+namespace driftlab::elementary {
 namespace {
 
-template <int W>
-struct Lanes {
-  typedef double D __attribute__((vector_size(W * sizeof(double))));
-  typedef uint64_t U __attribute__((vector_size(W * sizeof(uint64_t))));
-};
-template <>
-struct Lanes<1> {
-  typedef double D;
-  typedef uint64_t U;
-};
-
-template <int W>
-using D = typename Lanes<W>::D;
-template <int W>
-using U = typename Lanes<W>::U;
-
-template <int W>
-inline D<W> AsDouble(U<W> u) {
-  return __builtin_bit_cast(D<W>, u);
-}
-template <int W>
-inline U<W> AsBits(D<W> d) {
-  return __builtin_bit_cast(U<W>, d);
-}
-// mask ? a : b, lane by lane, for a mask of all-ones or all-zeros lanes.
-template <int W>
-inline D<W> Select(U<W> mask, D<W> a, D<W> b) {
-  return AsDouble<W>((AsBits<W>(a) & mask) | (AsBits<W>(b) & ~mask));
-}
-// All-ones where a > b, for a, b < 2^63 (bit patterns of non-negative doubles compare as the
-// doubles do): the borrow of b - a is its top bit.
-template <int W>
-inline U<W> GreaterMask(U<W> a, U<W> b) {
-  return U<W>{} - ((b - a) >> 63);
-}
-// Lane i of a mask (W = 1: the value itself).
-template <int W>
-inline uint64_t GetLane(U<W> v, int i) {
-  if constexpr (W == 1) {
-    (void)i;
-    return v;
-  } else {
-    return v[i];
-  }
-}
-// x clamped to [lo, hi] lane by lane (lo <= hi; a NaN lane stays NaN).
-template <int W>
-inline D<W> Clamp(D<W> x, double lo, double hi) {
-  if constexpr (W == 1) {
-    return x < lo ? lo : (hi < x ? hi : x);
-  } else {
-    for (int i = 0; i < W; ++i) x[i] = x[i] < lo ? lo : (hi < x[i] ? hi : x[i]);
-    return x;
-  }
-}
-// floor, lane by lane.
-template <int W>
-inline D<W> Floor(D<W> x) {
-  if constexpr (W == 1) {
-    return __builtin_floor(x);
-  } else {
-    for (int i = 0; i < W; ++i) x[i] = __builtin_floor(x[i]);
-    return x;
-  }
-}
-template <int W>
-inline D<W> Splat(double x) {
-  if constexpr (W == 1) {
-    return x;
-  } else {
-    return D<W>{} + x;
-  }
-}
-template <int W>
-inline D<W> Sqrt(D<W> x) {
-  if constexpr (W == 1) {
-    return __builtin_sqrt(x);
-  } else {
-    for (int i = 0; i < W; ++i) x[i] = __builtin_sqrt(x[i]);
-    return x;
-  }
-}
-
-constexpr double kTwoPow52 = 4503599627370496.0;
-constexpr uint64_t kTwoPow52Bits = 0x4330000000000000ull;  // the double 2^52
-
-// u as a double, exactly, for u < 2^52.
-template <int W>
-inline D<W> ToDouble(U<W> u) {
-  return AsDouble<W>(u | kTwoPow52Bits) - kTwoPow52;
-}
+using lanes::AsBits;
+using lanes::AsDouble;
+using lanes::D;
+using lanes::GetLane;
+using lanes::GreaterMask;
+using lanes::Select;
+using lanes::Splat;
+using lanes::ToDouble;
+using lanes::U;
 
 // ln 2 split so that e * kLn2Hi is exact for |e| < 2^11 (the fdlibm split: kLn2Hi has 32
 // significant bits). ln 2 = 0.693147180559945309417232121458...
@@ -356,7 +276,7 @@ inline double Ln(double x) {
 }
 
 // sin x and cos x: SinCos for |x| < 1.5e6 (its Cody-Waite reduction is exact there); beyond, the
-// C library's (no navigation angle gets there; said in the README).
+// C library's (no navigation angle gets there; a documented limit of the same-bits guarantee).
 inline void SinCosScalar(double x, double* s, double* c) {
   if (x > -1.5e6 && x < 1.5e6) {
     SinCos<1>(x, *s, *c);
@@ -506,4 +426,4 @@ inline double LgammaPositive(double a) {
 }
 
 }  // namespace
-}  // namespace driftlab::lane_math
+}  // namespace driftlab::elementary
