@@ -1,26 +1,45 @@
 #!/usr/bin/env bash
-# Installs every Debian 12 package driftlab's build, tests and clients need.
-# Non-interactive and idempotent: packages already installed are left alone.
-# `bash bootstrap.sh --only LABEL PACKAGE...` installs those packages the same way instead
-# (scripts/ci-packages.sh: the packages only CI's tests need).
+# Installs the Debian 12 packages driftlab needs.
+#   bash bootstrap.sh           what building and running `driftlab` and `driftlab-server` needs
+#                               (the README's first command): compiler, CMake, the libraries
+#   bash bootstrap.sh --tests   that and what the tests need (scripts/test.sh): the Python stack of
+#                               clients/python and the test scripts, git, openssl, ccache,
+#                               clang-format; CI's own packages are in scripts/ci-packages.sh
+#   bash bootstrap.sh --only LABEL PACKAGE...   those packages the same way
+# Non-interactive and idempotent: packages already installed are left alone. Prints the time it
+# took when it installed something.
 set -euo pipefail
 
 label=bootstrap
-packages=(
-  build-essential cmake ninja-build pkg-config git ca-certificates
+build_packages=(
+  build-essential cmake ninja-build pkg-config
   libeigen3-dev libceres-dev libtbb-dev
   libprotobuf-dev protobuf-compiler libgrpc++-dev protobuf-compiler-grpc
-  libyaml-cpp-dev libcli11-dev libfmt-dev libspdlog-dev libsqlite3-dev libssl-dev openssl
+  libyaml-cpp-dev libcli11-dev libfmt-dev libspdlog-dev libsqlite3-dev libssl-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3-grpcio python3-protobuf python3-matplotlib python3-numpy
-  clang-format ccache
   libjs-dygraphs
 )
-if [ "${1:-}" = "--only" ]; then
-  label="$2"
-  shift 2
-  packages=("$@")
-fi
+test_packages=(
+  git ca-certificates openssl ccache clang-format
+  python3-grpcio python3-protobuf python3-numpy python3-pandas python3-matplotlib python3-yaml
+  python3-pip python3-setuptools python3-wheel python3-venv
+)
+case "${1:-}" in
+  "") packages=("${build_packages[@]}") ;;
+  --tests)
+    label=bootstrap-tests
+    packages=("${build_packages[@]}" "${test_packages[@]}")
+    ;;
+  --only)
+    label="$2"
+    shift 2
+    packages=("$@")
+    ;;
+  *)
+    echo "usage: bash bootstrap.sh [--tests | --only LABEL PACKAGE...]" >&2
+    exit 2
+    ;;
+esac
 
 missing=()
 for p in "${packages[@]}"; do
@@ -36,6 +55,8 @@ fi
 
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+start=$(date +%s)
 echo "${label}: installing ${missing[*]}"
 $SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -qq
 $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends "${missing[@]}"
+echo "${label}: installed ${#missing[@]} packages (with their dependencies) in $(($(date +%s) - start)) s"

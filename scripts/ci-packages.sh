@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Debian packages CI's tests need beyond bootstrap.sh: slurm-wlm and munge (tests/deploy/
+# Debian packages some tests need beyond bootstrap.sh --tests (scripts/test.sh installs them too, so
+# that no test is skipped for a missing package): slurm-wlm and munge (tests/deploy/
 # slurm_test.py starts a one-node Slurm cluster), clang-14 and libclang-rt-14-dev (libFuzzer
 # targets, fuzz/ci.sh), chromium (tests/report/browser_test.py loads the HTML reports
 # headless), g++-aarch64-linux-gnu and qemu-user-static (tests/arm64/same_bits.sh builds the lane

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Installs dependencies, builds driftlab with its tests and benchmarks, and runs every test: the
-# README's test command. Prints the machine factor (scripts/ci/machine_factor.sh: how much slower
+# Installs every package the tests need, builds driftlab with its tests and benchmarks, and runs
+# every test: the README's test command. Prints the machine factor (scripts/ci/machine_factor.sh: how much slower
 # than the reference machine this one is) and the time of each step, so a slow machine is visible.
 # Usage: scripts/test.sh [BUILD_DIR] [--build-only]
 #   extra CMake flags in $DRIFTLAB_CMAKE_FLAGS, extra ctest flags in $DRIFTLAB_CTEST_FLAGS.
@@ -26,7 +26,11 @@ report() {
 }
 trap report EXIT
 
-bash bootstrap.sh
+# Every package a test needs, so that no test is skipped for a missing one: the build's and the
+# tests' (bootstrap.sh --tests), and the ones CI's tests need (Slurm, clang-14, chromium, the arm64
+# cross compiler and qemu; scripts/ci-packages.sh).
+bash bootstrap.sh --tests
+bash scripts/ci-packages.sh
 done_step packages
 factor=$(bash scripts/ci/machine_factor.sh)
 done_step factor
