@@ -1,8 +1,7 @@
 #!/usr/bin/python3
 """Runs a driftlab job on a driftlab-server and plots its error envelopes.
 
-    PYTHONPATH=<build>/python:clients/python \\
-      /usr/bin/python3 clients/python/examples/run_job.py --server HOST:PORT \\
+    /usr/bin/python3 clients/python/examples/run_job.py --server HOST:PORT \\
       examples/car_drive.json --runs 20 --plot envelopes.png [--out result.json]
 
 Submits the job (JSON job file), prints progress lines while the server runs it, prints the
@@ -13,18 +12,13 @@ names the field), 1 any other failure (server unreachable, bad token, job failed
 
 import argparse
 import os
-import pathlib
 import sys
 
 try:
-    import driftlab_client
-except ImportError:  # run from the source tree without PYTHONPATH for the package
-    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent.parent))
-    try:
-        import driftlab_client
-    except ImportError as error:
-        sys.exit(f"error: {error}; set PYTHONPATH=<build>/python (generated stubs) "
-                 "and clients/python")
+    import driftlab
+except ImportError as error:
+    sys.exit(f"error: {error}; install the package (pip install --no-build-isolation "
+             "./clients/python) or set PYTHONPATH=<build>/python")
 
 import grpc
 from driftlab.v1 import service_pb2
@@ -46,28 +40,17 @@ def main():
     parser.add_argument("--out", default=None, help="write the result JSON here")
     args = parser.parse_args()
 
-    client = driftlab_client.connect(args.server, token=args.token, tls_ca=args.tls_ca)
+    client = driftlab.connect(args.server, token=args.token, tls_ca=args.tls_ca)
     try:
         job_id = client.submit(args.job, runs=args.runs, seed=args.seed)
         print(f"submitted job {job_id} to {args.server}", file=sys.stderr)
-        last_decile = -1
-        final = None
-        for status in client.watch(job_id, timeout_s=args.timeout):
-            final = status
-            if status.runs_total:
-                decile = 10 * status.runs_done // status.runs_total
-                if decile > last_decile:
-                    last_decile = decile
-                    print(f"progress: {10 * decile:3d}% ({status.runs_done}/{status.runs_total} "
-                          f"runs, {status.elapsed_s:.1f} s)", file=sys.stderr)
-        if final is None or final.state not in driftlab_client.FINAL_STATES:
-            final = client.get(job_id)
+        final = client.wait(job_id, timeout_s=args.timeout, progress=True)
         if final.state != service_pb2.SUCCEEDED:
             state = service_pb2.JobState.Name(final.state)
             print(f"error: job {job_id} {state}: {final.error}", file=sys.stderr)
             return 1
         result = client.result(job_id)
-    except driftlab_client.DriftlabError as error:
+    except driftlab.DriftlabError as error:
         print(f"error: {error.details}" if error.code == grpc.StatusCode.INVALID_ARGUMENT
               else f"error: {error}", file=sys.stderr)
         return 2 if error.code == grpc.StatusCode.INVALID_ARGUMENT else 1
@@ -77,12 +60,12 @@ def main():
     finally:
         client.close()
 
-    print("\n".join(driftlab_client.summary_lines(result)))
+    print("\n".join(driftlab.summary_lines(result)))
     if args.out:
-        driftlab_client.write_result(result, args.out)
+        result.write(args.out)
         print(f"wrote {args.out}")
     if args.plot:
-        driftlab_client.plot_envelopes(result, args.plot)
+        driftlab.plot_envelopes(result, args.plot)
         print(f"wrote {args.plot}")
     return 0
 
