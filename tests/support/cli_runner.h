@@ -55,12 +55,11 @@ class Scratch {
   fs::path dir_;
 };
 
-// Runs the driftlab binary with `args`; stdout and stderr go to files in `scratch`.
-inline Result RunDriftlab(const std::vector<std::string>& args, const Scratch& scratch) {
+// Runs the program argv_strings[0] (a path) with its arguments; stdout and stderr go to files in
+// `scratch`.
+inline Result RunProgram(std::vector<std::string> argv_strings, const Scratch& scratch) {
   const fs::path out_file = scratch.dir() / "stdout.txt";
   const fs::path err_file = scratch.dir() / "stderr.txt";
-  std::vector<std::string> argv_strings = {DRIFTLAB_CLI};
-  argv_strings.insert(argv_strings.end(), args.begin(), args.end());
   std::vector<char*> argv;
   for (std::string& s : argv_strings) argv.push_back(s.data());
   argv.push_back(nullptr);
@@ -82,6 +81,13 @@ inline Result RunDriftlab(const std::vector<std::string>& args, const Scratch& s
   result.out = ReadFile(out_file);
   result.err = ReadFile(err_file);
   return result;
+}
+
+// Runs the driftlab binary with `args`.
+inline Result RunDriftlab(const std::vector<std::string>& args, const Scratch& scratch) {
+  std::vector<std::string> argv_strings = {DRIFTLAB_CLI};
+  argv_strings.insert(argv_strings.end(), args.begin(), args.end());
+  return RunProgram(argv_strings, scratch);
 }
 
 }  // namespace driftlab::testing
