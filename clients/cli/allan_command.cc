@@ -37,6 +37,7 @@
 #include "driftlab/app/calibration_job.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/units.h"
+#include "json_values.h"
 
 namespace driftlab::cli {
 namespace {
@@ -84,22 +85,15 @@ constexpr DisplayUnits kAccelDisplayMg{
 
 using Column = app::RateColumn;
 
-std::vector<std::string> SplitNames(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream in(text);
-  std::string name;
-  while (std::getline(in, name, ',')) {
-    const size_t a = name.find_first_not_of(" \t"), b = name.find_last_not_of(" \t");
-    out.push_back(a == std::string::npos ? "" : name.substr(a, b - a + 1));
-  }
-  return out;
+return out;
 }
 
 // Reads `path` (calibration_job.h ReadNumericCsv) and selects the columns as SI rates.
 std::vector<Column> ReadColumns(const AllanCliOptions& options) {
   const app::NumericTable table = app::ReadNumericCsv(options.data_path);
   return app::SelectRateColumns(
-      table, options.columns.empty() ? std::vector<std::string>{} : SplitNames(options.columns),
+      table,
+      options.columns.empty() ? std::vector<std::string>{} : SplitColumnNames(options.columns),
       options.unit, options.rate_hz, options.data_path, "--columns", "--unit");
 }
 
@@ -119,22 +113,6 @@ const char* NoiseName(AllanNoiseType type) {
       break;
   }
   return "auto";
-}
-
-pb::Value Number(double v) {
-  pb::Value value;
-  if (std::isfinite(v)) {
-    value.set_number_value(v);
-  } else {
-    value.set_null_value(pb::NULL_VALUE);
-  }
-  return value;
-}
-
-pb::Value Text(const std::string& s) {
-  pb::Value value;
-  value.set_string_value(s);
-  return value;
 }
 
 void Set(pb::Struct& s, const std::string& key, pb::Value value) {
@@ -182,17 +160,17 @@ pb::Value AnalyseColumn(const Column& column, const AllanCliOptions& options) {
              "clusters", "noise (EDF)");
   pb::Value result;
   pb::Struct& s = *result.mutable_struct_value();
-  Set(s, "name", Text(column.name));
-  Set(s, "quantity", Text(u.quantity));
-  Set(s, "input_unit", Text(column.unit));
+  Set(s, "name", JsonText(column.name));
+  Set(s, "quantity", JsonText(u.quantity));
+  Set(s, "input_unit", JsonText(column.unit));
   Set(s, "increments", [&] {
     pb::Value v;
     v.set_bool_value(column.increment);
     return v;
   }());
-  Set(s, "n_samples", Number(static_cast<double>(column.samples.size())));
-  Set(s, "si_unit", Text(u.si));
-  Set(s, "datasheet_unit", Text(u.adev));
+  Set(s, "n_samples", JsonNumber(static_cast<double>(column.samples.size())));
+  Set(s, "si_unit", JsonText(u.si));
+  Set(s, "datasheet_unit", JsonText(u.adev));
   pb::ListValue& points = *(*s.mutable_fields())["points"].mutable_list_value();
   for (const AllanPoint& p : curve) {
     fmt::print("  {:>12.6g}  {:>12.6g}  {:>12.6g} - {:>12.6g}  {:>10.4g}  {:>10}  {}\n", p.tau_s,
@@ -200,15 +178,15 @@ pb::Value AnalyseColumn(const Column& column, const AllanCliOptions& options) {
                p.edf, p.n_clusters, NoiseName(p.noise_type));
     pb::Value point;
     pb::Struct& ps = *point.mutable_struct_value();
-    Set(ps, "tau_s", Number(p.tau_s));
-    Set(ps, "adev", Number(p.adev));
-    Set(ps, "adev_low", Number(p.adev_low));
-    Set(ps, "adev_high", Number(p.adev_high));
-    Set(ps, "edf", Number(p.edf));
-    Set(ps, "n_clusters", Number(static_cast<double>(p.n_clusters)));
-    Set(ps, "m", Number(static_cast<double>(p.m)));
-    Set(ps, "noise_type", Text(NoiseName(p.noise_type)));
-    Set(ps, "adev_datasheet", Number(FromSi(p.adev, u.adev)));
+    Set(ps, "tau_s", JsonNumber(p.tau_s));
+    Set(ps, "adev", JsonNumber(p.adev));
+    Set(ps, "adev_low", JsonNumber(p.adev_low));
+    Set(ps, "adev_high", JsonNumber(p.adev_high));
+    Set(ps, "edf", JsonNumber(p.edf));
+    Set(ps, "n_clusters", JsonNumber(static_cast<double>(p.n_clusters)));
+    Set(ps, "m", JsonNumber(static_cast<double>(p.m)));
+    Set(ps, "noise_type", JsonText(NoiseName(p.noise_type)));
+    Set(ps, "adev_datasheet", JsonNumber(FromSi(p.adev, u.adev)));
     *points.add_values() = std::move(point);
   }
 
@@ -223,16 +201,16 @@ pb::Value AnalyseColumn(const Column& column, const AllanCliOptions& options) {
       b.set_bool_value(fit.found());
       return b;
     }());
-    Set(ts, "si", Number(fit.value));
-    Set(ts, "si_unit", Text(term.si_unit));
-    Set(ts, "datasheet_unit", Text(term.unit));
-    Set(ts, "datasheet_value", Number(fit.found() ? FromSi(fit.value, term.unit) : NAN));
-    Set(ts, "tau_min_s", Number(fit.tau_min_s));
-    Set(ts, "tau_max_s", Number(fit.tau_max_s));
-    Set(ts, "n_points", Number(fit.n_points));
+    Set(ts, "si", JsonNumber(fit.value));
+    Set(ts, "si_unit", JsonText(term.si_unit));
+    Set(ts, "datasheet_unit", JsonText(term.unit));
+    Set(ts, "datasheet_value", JsonNumber(fit.found() ? FromSi(fit.value, term.unit) : NAN));
+    Set(ts, "tau_min_s", JsonNumber(fit.tau_min_s));
+    Set(ts, "tau_max_s", JsonNumber(fit.tau_max_s));
+    Set(ts, "n_points", JsonNumber(fit.n_points));
     if (fit.found()) {
       const std::string datasheet = FormatQuantity(fit.value, term.unit, 4);
-      Set(ts, "datasheet", Text(datasheet));
+      Set(ts, "datasheet", JsonText(datasheet));
       fmt::print("    {:<26} {} = {:<24} [SI: {:.6g} {}]  from tau {:g}-{:g} s ({} points)\n",
                  term.label, term.symbol, datasheet, fit.value, term.si_unit, fit.tau_min_s,
                  fit.tau_max_s, fit.n_points);
@@ -256,10 +234,10 @@ int RunAllan(const AllanCliOptions& options) {
     }
     const std::vector<Column> columns = ReadColumns(options);
     pb::Struct& s = *report.mutable_struct_value();
-    Set(s, "file", Text(options.data_path));
-    Set(s, "rate_hz", Number(options.rate_hz));
-    Set(s, "confidence", Number(0.95));
-    Set(s, "points_per_octave", Number(options.points_per_octave));
+    Set(s, "file", JsonText(options.data_path));
+    Set(s, "rate_hz", JsonNumber(options.rate_hz));
+    Set(s, "confidence", JsonNumber(0.95));
+    Set(s, "points_per_octave", JsonNumber(options.points_per_octave));
     pb::ListValue& list = *(*s.mutable_fields())["columns"].mutable_list_value();
     for (const Column& column : columns) *list.add_values() = AnalyseColumn(column, options);
   } catch (const SpecError& e) {

@@ -20,9 +20,8 @@
 #include "driftlab/v1/job.pb.h"
 
 namespace driftlab::cli {
-namespace {
 
-std::vector<std::string> SplitNames(const std::string& text) {
+std::vector<std::string> SplitColumnNames(const std::string& text) {
   std::vector<std::string> out;
   std::stringstream in(text);
   std::string name;
@@ -32,8 +31,6 @@ std::vector<std::string> SplitNames(const std::string& text) {
   }
   return out;
 }
-
-}  // namespace
 
 int RunAllanFit(const AllanFitOptions& options) {
   v1::NoiseModelFit fit;
@@ -67,7 +64,7 @@ int RunAllanFit(const AllanFitOptions& options) {
                            ? std::vector<std::string>{"omega_x_rad_per_s", "omega_y_rad_per_s",
                                                       "omega_z_rad_per_s", "f_x_m_per_s2",
                                                       "f_y_m_per_s2",      "f_z_m_per_s2"}
-                           : SplitNames(options.columns);
+                           : SplitColumnNames(options.columns);
     const app::NumericTable table = app::ReadNumericCsv(
         options.data_path, settings.columns, options.columns.empty() ? "DATA" : "--columns");
     fit = app::RunNoiseFit(settings, table);

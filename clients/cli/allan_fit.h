@@ -9,8 +9,12 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 namespace driftlab::cli {
+
+// Comma-separated column names (--columns), each trimmed of spaces and tabs.
+std::vector<std::string> SplitColumnNames(const std::string& text);
 
 struct AllanFitOptions {
   std::string data_path;

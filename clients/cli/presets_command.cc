@@ -25,6 +25,7 @@
 #include "driftlab/sensor_terms.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/units.h"
+#include "json_values.h"
 
 namespace driftlab::cli {
 namespace {
@@ -49,30 +50,14 @@ struct Row {
   pb::Value json;
 };
 
-pb::Value Number(double v) {
-  pb::Value value;
-  if (std::isfinite(v)) {
-    value.set_number_value(v);
-  } else {
-    value.set_null_value(pb::NULL_VALUE);
-  }
-  return value;
-}
-
-pb::Value Text(const std::string& s) {
-  pb::Value value;
-  value.set_string_value(s);
-  return value;
-}
-
 // {"si": v, "si_unit": "...", "datasheet": "..."} for a scalar.
 Row Scalar(std::string key, std::string label, double value_si, const char* unit,
            const char* si_unit) {
   Row row{std::move(key), std::move(label), Datasheet(value_si, unit), Si(value_si, si_unit), {}};
   pb::Struct& s = *row.json.mutable_struct_value();
-  (*s.mutable_fields())["si"] = Number(value_si);
-  (*s.mutable_fields())["si_unit"] = Text(si_unit);
-  (*s.mutable_fields())["datasheet"] = Text(row.datasheet);
+  (*s.mutable_fields())["si"] = JsonNumber(value_si);
+  (*s.mutable_fields())["si_unit"] = JsonText(si_unit);
+  (*s.mutable_fields())["datasheet"] = JsonText(row.datasheet);
   return row;
 }
 
@@ -82,7 +67,7 @@ Row Noise(std::string key, std::string label, double value_si, const char* unit,
   Row row = Scalar(std::move(key), std::move(label), value_si, unit, si_unit);
   row.datasheet += " = " + Datasheet(value_si, density_unit);
   (*row.json.mutable_struct_value()->mutable_fields())["datasheet_density"] =
-      Text(Datasheet(value_si, density_unit));
+      JsonText(Datasheet(value_si, density_unit));
   return row;
 }
 
@@ -101,13 +86,13 @@ Row Values(std::string key, std::string label, const double* values, int count, 
     }
     row.datasheet += fmt::format("{:.{}g}", ds, kDigits);
     row.si += fmt::format("{:.6g}", values[i]);
-    *si_list.add_values() = Number(values[i]);
-    *ds_list.add_values() = Number(ds);
+    *si_list.add_values() = JsonNumber(values[i]);
+    *ds_list.add_values() = JsonNumber(ds);
   }
   row.datasheet += std::string(" ") + unit;
   if (*si_unit != '\0') row.si += std::string(" ") + si_unit;
-  (*s.mutable_fields())["si_unit"] = Text(si_unit);
-  (*s.mutable_fields())["datasheet_unit"] = Text(unit);
+  (*s.mutable_fields())["si_unit"] = JsonText(si_unit);
+  (*s.mutable_fields())["datasheet_unit"] = JsonText(unit);
   return row;
 }
 
@@ -151,8 +136,8 @@ pb::Value RowsToJson(const std::vector<Row>& rows) {
 pb::Value PresetJson(const ImuErrorModel& model) {
   pb::Value value;
   pb::Struct& s = *value.mutable_struct_value();
-  (*s.mutable_fields())["name"] = Text(model.name);
-  (*s.mutable_fields())["description"] = Text(model.description);
+  (*s.mutable_fields())["name"] = JsonText(model.name);
+  (*s.mutable_fields())["description"] = JsonText(model.description);
   (*s.mutable_fields())["gyro"] = RowsToJson(TermRows(model, SensorTriad::kGyro, false));
   (*s.mutable_fields())["accel"] = RowsToJson(TermRows(model, SensorTriad::kAccel, false));
   for (const Row& row : TermRows(model, SensorTriad::kGyro, true)) {

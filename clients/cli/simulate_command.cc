@@ -18,11 +18,10 @@
 #include "driftlab/io.h"
 #include "driftlab/simulate.h"
 #include "driftlab/spec_error.h"
+#include "driftlab/units.h"
 
 namespace driftlab::cli {
 namespace {
-
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 void PrintSummary(const app::JobFile& file, const SimulationSpec& spec, const SensorRun* sensor,
                   const SimulationSummary& summary, const std::filesystem::path& out_dir) {

@@ -17,6 +17,7 @@
 #include "driftlab/calib/tumble.h"
 #include "driftlab/presets.h"
 #include "driftlab/spec_error.h"
+#include "support/spec_errors.h"
 
 namespace driftlab::calib {
 namespace {
@@ -34,14 +35,7 @@ ImuErrorModel NoiseFreeModel() {
   return m;
 }
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const SpecError& e) {
-    return e.what();
-  }
-  return "";
-}
+using testing::ErrorOf;
 
 TEST(MultiPosition, NoiseFreeTumbleRecoversInjectedErrorsExactly) {
   TumbleSpec spec;

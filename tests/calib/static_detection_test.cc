@@ -14,18 +14,12 @@
 #include "driftlab/calib/tumble.h"
 #include "driftlab/presets.h"
 #include "driftlab/spec_error.h"
+#include "support/spec_errors.h"
 
 namespace driftlab::calib {
 namespace {
 
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const SpecError& e) {
-    return e.what();
-  }
-  return "";
-}
+using testing::ErrorOf;
 
 TEST(StaticDetection, FindsEveryPoseOfANoisyTumbleInsideItsTrueInterval) {
   TumbleSpec spec;

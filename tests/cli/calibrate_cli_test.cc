@@ -15,8 +15,6 @@
 namespace driftlab::testing {
 namespace {
 
-const std::string kData = DRIFTLAB_CLI_TEST_DATA;
-
 // The number after `"value":` following `"name": "<name>"` in the JSON result.
 double ValueOf(const std::string& json, const std::string& name, const std::string& key) {
   const size_t at = json.find("\"" + name + "\"");
@@ -29,8 +27,8 @@ TEST(CalibrateCli, Seed003ReferenceGivesSensitivitiesAndNulls) {
   Scratch scratch;
   const auto out = scratch.dir() / "calib.json";
   const Result r =
-      RunDriftlab({"calibrate", "reference", kData + "/calib_seed003_gyro.csv", "--input-unit",
-                   "deg/s", "--output-unit", "V", "--out", out.string()},
+      RunDriftlab({"calibrate", "reference", (kCliData / "calib_seed003_gyro.csv").string(),
+                   "--input-unit", "deg/s", "--output-unit", "V", "--out", out.string()},
                   scratch);
   ASSERT_EQ(r.exit_status, 0) << r.err;
   EXPECT_NE(r.out.find("x.sensitivity"), std::string::npos) << r.out;

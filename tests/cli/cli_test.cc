@@ -20,9 +20,6 @@ using driftlab::testing::Result;
 using driftlab::testing::RunDriftlab;
 using driftlab::testing::Scratch;
 
-const fs::path kExamples = fs::path(DRIFTLAB_SOURCE_DIR) / "examples";
-const fs::path kData = DRIFTLAB_CLI_TEST_DATA;
-
 std::vector<fs::path> ExampleJobs() {
   std::vector<fs::path> jobs;
   for (const auto& entry : fs::directory_iterator(kExamples)) {
@@ -103,7 +100,7 @@ class BadJobFile : public testing::TestWithParam<BadJob> {};
 TEST_P(BadJobFile, IsRejectedWithOneMessageAndNothingWritten) {
   Scratch scratch;
   const fs::path out_dir = scratch.dir() / "out";
-  const fs::path job = kData / GetParam().file;
+  const fs::path job = kCliData / GetParam().file;
   const Result r = RunDriftlab({"simulate", job.string(), "--out", out_dir.string()}, scratch);
   EXPECT_EQ(r.exit_status, 2);
   EXPECT_EQ(r.err, "error: " + GetParam().message + "\n");
@@ -148,13 +145,13 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(Cli, HugeGnssInsSimRateAndAliasedShipPeriodAreRefusedWithStatus2) {
   Scratch scratch;
   const Result rate =
-      RunDriftlab({"validate", (kData / "bad_gnss_ins_sim_huge_rate.json").string()}, scratch);
+      RunDriftlab({"validate", (kCliData / "bad_gnss_ins_sim_huge_rate.json").string()}, scratch);
   EXPECT_EQ(rate.exit_status, 2);
   EXPECT_NE(rate.err.find("bad_gnss_ins_sim_huge_rate.csv:5 (yaw): "), std::string::npos)
       << rate.err;
   EXPECT_NE(rate.err.find("|yaw rate| <= 5729.57"), std::string::npos) << rate.err;
   const Result ship =
-      RunDriftlab({"validate", (kData / "bad_ship_roll_period.json").string()}, scratch);
+      RunDriftlab({"validate", (kCliData / "bad_ship_roll_period.json").string()}, scratch);
   EXPECT_EQ(ship.exit_status, 2);
   EXPECT_NE(ship.err.find("motion.segments[0].ship_motion.roll_period_s: 0.001 is not allowed; "
                           "allowed: roll_period_s >= 0.04 s"),
@@ -166,10 +163,10 @@ TEST(Cli, JsonSyntaxErrorIsOneLineWithStatus2) {
   Scratch scratch;
   const fs::path out_dir = scratch.dir() / "out";
   const Result r = RunDriftlab(
-      {"simulate", (kData / "bad_syntax.json").string(), "--out", out_dir.string()}, scratch);
+      {"simulate", (kCliData / "bad_syntax.json").string(), "--out", out_dir.string()}, scratch);
   EXPECT_EQ(r.exit_status, 2);
   EXPECT_EQ(CountLines(r.err), 1) << r.err;
-  EXPECT_TRUE(r.err.starts_with("error: " + (kData / "bad_syntax.json").string() +
+  EXPECT_TRUE(r.err.starts_with("error: " + (kCliData / "bad_syntax.json").string() +
                                 ": invalid JSON at line 3, column "))
       << r.err;
   EXPECT_FALSE(fs::exists(out_dir));
@@ -180,7 +177,7 @@ TEST(Cli, EngineRejectionIsReportedBeforeTheOutputDirectoryIsCreated) {
   Scratch scratch;
   const fs::path out_dir = scratch.dir() / "out";
   const Result r = RunDriftlab(
-      {"simulate", (kData / "bad_static_at_speed.json").string(), "--out", out_dir.string()},
+      {"simulate", (kCliData / "bad_static_at_speed.json").string(), "--out", out_dir.string()},
       scratch);
   EXPECT_EQ(r.exit_status, 2);
   EXPECT_EQ(CountLines(r.err), 1) << r.err;

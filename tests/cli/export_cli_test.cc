@@ -18,9 +18,6 @@ using driftlab::testing::Result;
 using driftlab::testing::RunDriftlab;
 using driftlab::testing::Scratch;
 
-const fs::path kData = DRIFTLAB_CLI_TEST_DATA;
-const fs::path kExamples = fs::path(DRIFTLAB_SOURCE_DIR) / "examples";
-
 // Rows of a CSV file with a header, as numbers.
 std::vector<std::vector<double>> ReadCsv(const fs::path& path) {
   std::istringstream text(ReadFile(path));
@@ -39,7 +36,7 @@ std::vector<std::vector<double>> ReadCsv(const fs::path& path) {
 
 TEST(Export, WritesTheErroredDataOfOneSeededRun) {
   Scratch scratch;
-  const fs::path job = kData / "static_gyro_white_noise.json";
+  const fs::path job = kCliData / "static_gyro_white_noise.json";
   const Result r =
       RunDriftlab({"export", job.string(), "--out", (scratch.dir() / "a").string()}, scratch);
   ASSERT_EQ(r.exit_status, 0) << r.err;
@@ -79,7 +76,7 @@ TEST(Export, WritesTheErroredDataOfOneSeededRun) {
 
 TEST(Export, SameSeedAndRunGiveIdenticalFilesOtherRunsDiffer) {
   Scratch scratch;
-  const std::string job = (kData / "static_gyro_white_noise.json").string();
+  const std::string job = (kCliData / "static_gyro_white_noise.json").string();
   auto out = [&scratch](const char* name) { return (scratch.dir() / name).string(); };
   ASSERT_EQ(RunDriftlab({"export", job, "--out", out("a")}, scratch).exit_status, 0);
   ASSERT_EQ(RunDriftlab({"export", job, "--out", out("b"), "--seed", "42"}, scratch).exit_status,
@@ -98,7 +95,7 @@ TEST(Export, SameSeedAndRunGiveIdenticalFilesOtherRunsDiffer) {
 
 TEST(Export, SimulateWritesTheSameMeasuredDataAsExport) {
   Scratch scratch;
-  const std::string job = (kData / "static_gyro_white_noise.json").string();
+  const std::string job = (kCliData / "static_gyro_white_noise.json").string();
   ASSERT_EQ(
       RunDriftlab({"export", job, "--out", (scratch.dir() / "e").string()}, scratch).exit_status,
       0);

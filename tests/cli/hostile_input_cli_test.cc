@@ -26,8 +26,6 @@ using driftlab::testing::Result;
 using driftlab::testing::RunDriftlab;
 using driftlab::testing::Scratch;
 
-const fs::path kData = DRIFTLAB_CLI_TEST_DATA;
-
 fs::path Write(const Scratch& scratch, const std::string& name, const std::string& content) {
   const fs::path path = scratch.dir() / name;
   std::ofstream(path, std::ios::binary) << content;
@@ -126,7 +124,7 @@ TEST(HostileInput, DeeplyNestedJsonIsRefusedAtTheDepthLimit) {
 
 TEST(HostileInput, NonJsonSyntaxIsRefused) {
   Scratch scratch;
-  const std::string base = ReadFile(kData / "mc_small.json");
+  const std::string base = ReadFile(kCliData / "mc_small.json");
   // A trailing comma before the final '}'.
   const size_t last = base.rfind('}');
   const fs::path comma = Write(scratch, "comma.json", base.substr(0, last) + ",}\n");
@@ -154,7 +152,7 @@ TEST(HostileInput, OutputNeverReplacesASymlinkOrAFifo) {
   const fs::path target = Write(scratch, "precious.txt", "keep me\n");
   const fs::path link = scratch.dir() / "link.json";
   fs::create_symlink(target, link);
-  const fs::path sheet = kData / "datasheet_tactical.yaml";
+  const fs::path sheet = kCliData / "datasheet_tactical.yaml";
   ExpectRefused(RunDriftlab({"datasheet", sheet.string(), "--out", link.string()}, scratch),
                 "symbolic link");
   EXPECT_TRUE(fs::is_symlink(link));
@@ -197,7 +195,7 @@ TEST(HostileInput, InputsThatAreNotRegularFilesOrAreEmptyAreRefused) {
 TEST(HostileInput, UnsignedOptionsAreParsedStrictlyOnOneLine) {
   // --seed -1, 2^64 and 40 digits must not wrap to 2^64 - 1, nor --runs "" pass: all refused.
   Scratch scratch;
-  const std::string job = (kData / "mc_small.json").string();
+  const std::string job = (kCliData / "mc_small.json").string();
   const std::string out = (scratch.dir() / "r.json").string();
   for (const std::vector<std::string>& extra : {std::vector<std::string>{"--seed", "-1"},
                                                 {"--seed", "18446744073709551616"},
@@ -218,7 +216,7 @@ TEST(HostileInput, TokensWithControlOrNonAsciiBytesAreRefusedBeforeGrpc) {
   // A token with a CR, a newline or a non-ASCII byte (gRPC aborts on such metadata) is refused. The
   // server address is never contacted: the token is checked first (port 1 would refuse anyway).
   Scratch scratch;
-  const std::string job = (kData / "mc_small.json").string();
+  const std::string job = (kCliData / "mc_small.json").string();
   for (const std::string& token : {std::string("ab\rcd"), std::string("ab\ncd"),
                                    std::string("t\xc3\xb6ken"), std::string("a b")}) {
     const Result r = RunDriftlab({"run", job, "--out", (scratch.dir() / "r.json").string(),
@@ -251,7 +249,7 @@ TEST(HostileInput, ReportRefusesMeansItsPerRunValuesDoNotGive) {
   // naming the field, and writes nothing. (The renderer itself with such values:
   // tests/report/result_report_gate_test.cc, HtmlReport.ExtremeValuesRenderWithoutNonFinite.)
   Scratch scratch;
-  const std::string text = WithExtremeMeans(ReadFile(kData / "gate_baseline.json"), "1e308");
+  const std::string text = WithExtremeMeans(ReadFile(kCliData / "gate_baseline.json"), "1e308");
   ASSERT_NE(text.find("\"mean\": -1e308"), std::string::npos);
   const fs::path result = Write(scratch, "extreme.json", text);
   const fs::path html = scratch.dir() / "extreme.html";
@@ -267,7 +265,7 @@ TEST(HostileInput, MergeRefusesCountsThatWouldOverflow) {
   // `merge` of hand-edited huge counts: refused rather than summed past the signed range
   // (undefined behaviour, a negative count).
   Scratch scratch;
-  const std::string job = (kData / "mc_small.json").string();
+  const std::string job = (kCliData / "mc_small.json").string();
   std::vector<std::string> shards;
   for (const char* shard : {"0/2", "1/2"}) {
     const std::string out = (scratch.dir() / (std::string("s") + shard[0] + ".json")).string();

@@ -13,8 +13,6 @@
 namespace driftlab::testing {
 namespace {
 
-const std::string kData = DRIFTLAB_CLI_TEST_DATA;
-
 double NumberAfter(const std::string& text, const std::string& key) {
   const std::regex re("\"" + key + "\": ([-+0-9.eE]+)");
   std::smatch m;
@@ -26,7 +24,8 @@ TEST(NoiseFitCliTest, DatasheetWritesTheSensorFragmentAndShowsSiValues) {
   Scratch scratch;
   const auto out = scratch.dir() / "model.json";
   const Result r = RunDriftlab(
-      {"datasheet", kData + "/datasheet_tactical.yaml", "--out", out.string()}, scratch);
+      {"datasheet", (kCliData / "datasheet_tactical.yaml").string(), "--out", out.string()},
+      scratch);
   ASSERT_EQ(r.exit_status, 0) << r.err;
   // 0.15 deg/sqrt(h) = 0.15 * pi / 180 / 60 rad/sqrt(s) = 4.36332e-05 (6 significant digits shown).
   EXPECT_NE(r.out.find("4.36332e-05 rad/sqrt(s)"), std::string::npos) << r.out;
@@ -39,11 +38,13 @@ TEST(NoiseFitCliTest, DatasheetWritesTheSensorFragmentAndShowsSiValues) {
 
 TEST(NoiseFitCliTest, DatasheetErrorsNameKeyValueAndAllowedUnits) {
   Scratch scratch;
-  const Result r = RunDriftlab({"datasheet", kData + "/datasheet_wrong_dimension.yaml"}, scratch);
+  const Result r =
+      RunDriftlab({"datasheet", (kCliData / "datasheet_wrong_dimension.yaml").string()}, scratch);
   EXPECT_EQ(r.exit_status, 2);
   EXPECT_NE(r.err.find("gyro.arw: '0.15 deg/h'"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("deg/sqrt(h)"), std::string::npos) << r.err;
-  const Result u = RunDriftlab({"datasheet", kData + "/datasheet_unknown_key.yaml"}, scratch);
+  const Result u =
+      RunDriftlab({"datasheet", (kCliData / "datasheet_unknown_key.yaml").string()}, scratch);
   EXPECT_EQ(u.exit_status, 2);
   EXPECT_NE(u.err.find("accel.bias_stability"), std::string::npos) << u.err;
 }
@@ -69,9 +70,10 @@ TEST(NoiseFitCliTest, AllanFitRecoversWhiteNoiseAndWritesTheModel) {
     }
   }
   const auto model = scratch.dir() / "model.json";
-  const Result r = RunDriftlab({"allan", csv.string(), "--fit", "--rate", "100", "--out",
-                                model.string(), "--datasheet", kData + "/datasheet_tactical.yaml"},
-                               scratch);
+  const Result r =
+      RunDriftlab({"allan", csv.string(), "--fit", "--rate", "100", "--out", model.string(),
+                   "--datasheet", (kCliData / "datasheet_tactical.yaml").string()},
+                  scratch);
   ASSERT_EQ(r.exit_status, 0) << r.err << r.out;
   EXPECT_NE(r.out.find("not determined"), std::string::npos) << r.out;  // no B, K, Q, R in data
   EXPECT_NE(r.out.find("datasheet tactical"), std::string::npos) << r.out;

@@ -14,10 +14,9 @@
 namespace driftlab::testing {
 namespace {
 
-const fs::path kData = DRIFTLAB_CLI_TEST_DATA;
-const std::string kBaseline = (kData / "gate_baseline.json").string();
-const std::string kDegraded = (kData / "gate_degraded.json").string();
-const std::string kOtherJob = (kData / "gate_other_job.json").string();
+const std::string kBaseline = (kCliData / "gate_baseline.json").string();
+const std::string kDegraded = (kCliData / "gate_degraded.json").string();
+const std::string kOtherJob = (kCliData / "gate_other_job.json").string();
 
 size_t Count(const std::string& text, const std::string& what) {
   size_t n = 0;
@@ -57,7 +56,7 @@ TEST(ReportCommand, WritesOneSelfContainedHtmlFileWithInteractivePlots) {
 
 TEST(ReportCommand, BadResultFileExitsTwoNamingTheFile) {
   Scratch scratch;
-  const std::string not_a_result = (kData / "gate_rules.yaml").string();
+  const std::string not_a_result = (kCliData / "gate_rules.yaml").string();
   const Result r =
       RunDriftlab({"report", not_a_result, "--out", (scratch.dir() / "r.html").string()}, scratch);
   EXPECT_EQ(r.exit_status, 2);
@@ -162,14 +161,14 @@ TEST(GateCommand, RunsForChangePlansTheRunCount) {
 TEST(GateCommand, RulesFileDecidesWhatIsGatedAndHowTightly) {
   Scratch scratch;
   // 60 % everywhere: 1.5 x passes (paired, exact ratios).
-  const Result loose = RunDriftlab(
-      {"gate", kDegraded, "--baseline", kBaseline, "--rules", (kData / "gate_rules.yaml").string()},
-      scratch);
+  const Result loose = RunDriftlab({"gate", kDegraded, "--baseline", kBaseline, "--rules",
+                                    (kCliData / "gate_rules.yaml").string()},
+                                   scratch);
   EXPECT_EQ(loose.exit_status, 0) << loose.out << loose.err;
   EXPECT_NE(loose.out.find("epoch[t=600].velocity_down_m_per_s.std"), std::string::npos);
   // One metric at 20 % (JSON rules): exactly that one fails.
   const Result strict = RunDriftlab({"gate", kDegraded, "--baseline", kBaseline, "--rules",
-                                     (kData / "gate_rules_strict.yaml").string()},
+                                     (kCliData / "gate_rules_strict.yaml").string()},
                                     scratch);
   EXPECT_EQ(strict.exit_status, 1) << strict.out << strict.err;
   const std::vector<std::string> failed = FailLines(strict.out);
@@ -179,7 +178,7 @@ TEST(GateCommand, RulesFileDecidesWhatIsGatedAndHowTightly) {
 
 TEST(GateCommand, BadRulesAndBadArgumentsExitTwoNamingTheField) {
   Scratch scratch;
-  const std::string bad_rules = (kData / "gate_bad_rules.yaml").string();
+  const std::string bad_rules = (kCliData / "gate_bad_rules.yaml").string();
   const Result r =
       RunDriftlab({"gate", kBaseline, "--baseline", kBaseline, "--rules", bad_rules}, scratch);
   EXPECT_EQ(r.exit_status, 2);

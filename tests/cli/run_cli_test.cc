@@ -20,8 +20,6 @@ using driftlab::testing::Result;
 using driftlab::testing::RunDriftlab;
 using driftlab::testing::Scratch;
 
-const fs::path kData = DRIFTLAB_CLI_TEST_DATA;
-
 // The result JSON without its "timings" object (wall and CPU time measure the machine, not the
 // job) and without "engine_version"-independent parts: everything else must match to the byte.
 std::string WithoutTimings(std::string json) {
@@ -36,8 +34,8 @@ TEST(Run, WritesAResultAndASelfContainedReport) {
   Scratch scratch;
   const fs::path result = scratch.dir() / "out" / "result.json";
   const fs::path report = scratch.dir() / "out" / "report.html";
-  const Result r = RunDriftlab({"run", (kData / "mc_small.json").string(), "--out", result.string(),
-                                "--report", report.string(), "--threads", "2"},
+  const Result r = RunDriftlab({"run", (kCliData / "mc_small.json").string(), "--out",
+                                result.string(), "--report", report.string(), "--threads", "2"},
                                scratch);
   ASSERT_EQ(r.exit_status, 0) << r.err;
   EXPECT_NE(r.out.find("mc_small: runs 0..39 of 40, seed 3"), std::string::npos) << r.out;
@@ -68,7 +66,7 @@ TEST(Run, ConsistencyVerdictIsPrintedAndOnTheReportsFirstScreen) {
   const fs::path result = scratch.dir() / "result.json";
   const fs::path report = scratch.dir() / "report.html";
   // The covariance analysis needs the free vertical channel.
-  std::string text = ReadFile(kData / "mc_small.json");
+  std::string text = ReadFile(kCliData / "mc_small.json");
   text.replace(text.find("TRUTH_HEIGHT"), 12, "FREE");
   const fs::path job = scratch.dir() / "mc_small_free.json";
   std::ofstream(job) << text;
@@ -86,15 +84,15 @@ TEST(Run, ConsistencyVerdictIsPrintedAndOnTheReportsFirstScreen) {
   ASSERT_NE(verdict, std::string::npos);
   EXPECT_LT(verdict, html.find("<h2>Summary"));
   // Without a prediction or a filter there is nothing to judge, and nothing is printed.
-  const Result plain =
-      RunDriftlab({"run", (kData / "mc_small.json").string(), "--out", result.string()}, scratch);
+  const Result plain = RunDriftlab(
+      {"run", (kCliData / "mc_small.json").string(), "--out", result.string()}, scratch);
   ASSERT_EQ(plain.exit_status, 0) << plain.err;
   EXPECT_EQ((plain.out + plain.err).find("consistency:"), std::string::npos);
 }
 
 TEST(Run, FourShardsMergedEqualOneProcessAndThreadsDoNotMatter) {
   Scratch scratch;
-  const std::string job = (kData / "mc_small.json").string();
+  const std::string job = (kCliData / "mc_small.json").string();
   auto file = [&scratch](const std::string& name) { return (scratch.dir() / name).string(); };
   ASSERT_EQ(RunDriftlab({"run", job, "--out", file("one.json"), "--threads", "1", "-q"}, scratch)
                 .exit_status,
@@ -129,7 +127,7 @@ TEST(Run, FourShardsMergedEqualOneProcessAndThreadsDoNotMatter) {
 // lockstep runner (DRIFTLAB_ISA, inherited by the child process) and on the scalar reference.
 TEST(Run, EveryInstructionSetPathWritesTheSameResultFile) {
   Scratch scratch;
-  const std::string job = (kData / "mc_small.json").string();
+  const std::string job = (kCliData / "mc_small.json").string();
   auto file = [&scratch](const std::string& name) { return (scratch.dir() / name).string(); };
   std::vector<std::string> paths = {"scalar", "baseline"};
 #if defined(__x86_64__)
@@ -159,7 +157,7 @@ TEST(Run, EveryInstructionSetPathWritesTheSameResultFile) {
 
 TEST(Run, BadCommandLinesAndJobsNameTheField) {
   Scratch scratch;
-  const std::string job = (kData / "mc_small.json").string();
+  const std::string job = (kCliData / "mc_small.json").string();
   const std::string out = (scratch.dir() / "r.json").string();
   struct Case {
     std::vector<std::string> args;
@@ -169,9 +167,9 @@ TEST(Run, BadCommandLinesAndJobsNameTheField) {
       {{"run", job, "--out", out, "--runs", "0"}, "--runs: 0 is not allowed; allowed: 1 <= --runs"},
       {{"run", job, "--out", out, "--shard", "4/4"}, "--shard: 4/4 is not allowed"},
       {{"run", job, "--out", out, "--shard", "2"}, "--shard: 2 is not allowed"},
-      {{"run", (kData / "mc_bad_epochs.json").string(), "--out", out},
+      {{"run", (kCliData / "mc_bad_epochs.json").string(), "--out", out},
        "monte_carlo.epoch_times_s[1]"},
-      {{"run", (kData / "mc_bad_runs.json").string(), "--out", out},
+      {{"run", (kCliData / "mc_bad_runs.json").string(), "--out", out},
        "monte_carlo.runs: 0 is not allowed"},
       // The job's memory (2401 IMU increments of 48 bytes alone: 115 kB) over a 1 kB limit:
       // refused before the truth is generated, naming the option that raises the limit.
@@ -192,16 +190,16 @@ TEST(Gate, ADegradedPresetFailsAgainstTheOriginalsBaselineAndTheOriginalPasses) 
   Scratch scratch;
   auto file = [&scratch](const std::string& name) { return (scratch.dir() / name).string(); };
   ASSERT_EQ(
-      RunDriftlab({"run", (kData / "mc_small.json").string(), "--out", file("base.json"), "-q"},
+      RunDriftlab({"run", (kCliData / "mc_small.json").string(), "--out", file("base.json"), "-q"},
                   scratch)
           .exit_status,
       0);
   ASSERT_EQ(
-      RunDriftlab({"run", (kData / "mc_small.json").string(), "--out", file("again.json"), "-q"},
+      RunDriftlab({"run", (kCliData / "mc_small.json").string(), "--out", file("again.json"), "-q"},
                   scratch)
           .exit_status,
       0);
-  ASSERT_EQ(RunDriftlab({"run", (kData / "mc_small_degraded.json").string(), "--out",
+  ASSERT_EQ(RunDriftlab({"run", (kCliData / "mc_small_degraded.json").string(), "--out",
                          file("degraded.json"), "-q"},
                         scratch)
                 .exit_status,

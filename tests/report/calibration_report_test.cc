@@ -23,6 +23,7 @@
 #include "driftlab/spec_error.h"
 #include "support/cli_runner.h"
 #include "support/report_html.h"
+#include "support/spec_errors.h"
 
 namespace driftlab::app {
 namespace {
@@ -31,11 +32,7 @@ namespace fs = std::filesystem;
 using ::driftlab::testing::RunDriftlab;
 using ::driftlab::testing::Scratch;
 
-size_t Count(const std::string& text, const std::string& part) {
-  size_t n = 0;
-  for (size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++n;
-  return n;
-}
+using testing::Count;
 
 // Every opened element is closed in order (void elements and "/>" excepted): returns "" or the
 // first mismatch.
@@ -370,16 +367,7 @@ TEST(NoiseFitCore, DatasheetFiguresStandBesideTheTriadTerms) {
   EXPECT_NE(RenderNoiseFitReport(fit, "x").find("<th>datasheet</th>"), std::string::npos);
 }
 
-// Runs `f` and returns the SpecError message ("" if none).
-template <typename F>
-std::string ErrorOf(F f) {
-  try {
-    f();
-  } catch (const SpecError& e) {
-    return e.what();
-  }
-  return "";
-}
+using testing::ErrorOf;
 
 TEST(CalibrationCore, BadSettingsAndTablesNameTheFieldAndTheValue) {
   const NumericTable table = ToTable(TacticalTumble().recording);

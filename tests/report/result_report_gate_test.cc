@@ -19,12 +19,12 @@
 #include "driftlab/report/html_report.h"
 #include "driftlab/spec_error.h"
 #include "support/report_html.h"
+#include "support/spec_errors.h"
 
 namespace driftlab::app {
 namespace {
 
 namespace fs = std::filesystem;
-const fs::path kData = DRIFTLAB_CLI_TEST_DATA;
 
 // A synthetic result with known statistics: N runs, epochs every 60 s to 600 s, checkpoints at
 // 300 s and 600 s. Component c's statistics at time t are (c + 1) * (t / 600) times fixed base
@@ -98,16 +98,7 @@ v1::JobResult MakeResult(double scale, int runs = 50, const std::string& name = 
   return result;
 }
 
-// The SpecError message of `f()`, or "" when it does not throw.
-template <typename F>
-std::string ErrorOf(F f) {
-  try {
-    f();
-  } catch (const SpecError& e) {
-    return e.what();
-  }
-  return "";
-}
+using testing::ErrorOf;
 
 std::string Slurp(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -131,11 +122,7 @@ class TempDir {
   fs::path dir_;
 };
 
-size_t Count(const std::string& text, const std::string& what) {
-  size_t n = 0;
-  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-  return n;
-}
+using testing::Count;
 
 double MetricValue(const std::vector<Metric>& metrics, const std::string& name) {
   for (const Metric& m : metrics) {
@@ -709,8 +696,8 @@ TEST(Gate, DataFileDegradedCopyIsTheBaselineTimesOnePointFive) {
   // interpolated percentiles, CEP, 2DRMS) is positively homogeneous of degree 1, so each metric
   // is 1.5 x the baseline's up to the rounding of numpy's few operations per value (1e-12
   // relative is ~5000 ulp, far above them and far below the 10 % the gate resolves).
-  const v1::JobResult baseline = ReadJobResult(kData / "gate_baseline.json");
-  const v1::JobResult degraded = ReadJobResult(kData / "gate_degraded.json");
+  const v1::JobResult baseline = ReadJobResult(kCliData / "gate_baseline.json");
+  const v1::JobResult degraded = ReadJobResult(kCliData / "gate_degraded.json");
   EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(baseline.job(), degraded.job()));
   const std::vector<Metric> a = ListMetrics(baseline);
   const std::vector<Metric> b = ListMetrics(degraded);
@@ -797,7 +784,7 @@ TEST(Report, DataFileResultRendersAndIsWellFormedXml) {
   // text removed) must be well formed; Python's XML parser reads the report body after the doctype
   // (the report uses only XML-compatible HTML: every element closed, entities escaped).
   std::string html = ::driftlab::testing::WithoutScriptText(
-      RenderHtmlReport(ReadJobResult(kData / "gate_baseline.json")));
+      RenderHtmlReport(ReadJobResult(kCliData / "gate_baseline.json")));
   for (const char* entity : {"&sigma;", "&plusmn;"}) {
     for (size_t at = html.find(entity); at != std::string::npos; at = html.find(entity)) {
       html.replace(at, std::strlen(entity), "s");

@@ -29,8 +29,6 @@ namespace driftlab::testing {
 using Eigen::Quaterniond;
 using Eigen::Vector3d;
 
-inline constexpr double kDeg = M_PI / 180.0;
-
 // 10 s at rest, accelerate to 15 m/s, turn 90 deg, 30 s straight, turn 180 deg, then a final
 // straight of final_straight_s.
 inline MotionSpec DriveWithFinalStraight(double final_straight_s) {

@@ -6,6 +6,13 @@
 
 namespace driftlab::testing {
 
+// How often `part` occurs in `text` (overlapping occurrences counted).
+inline size_t Count(const std::string& text, const std::string& part) {
+  size_t n = 0;
+  for (size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++n;
+  return n;
+}
+
 // `html` with the text of every <script> element removed (the <script> and </script> tags kept).
 inline std::string WithoutScriptText(const std::string& html) {
   std::string out;

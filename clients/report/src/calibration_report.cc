@@ -22,7 +22,7 @@ using svg::Num;
 
 // Colours of the residual series and of the Allan plots (ColorBrewer "Set1").
 constexpr const char* kSeriesColors[3] = {"#e41a1c", "#377eb8", "#4daf4a"};
-constexpr const char* kRmsColor = "#888888";
+constexpr const char* kResidualRmsColor = "#888888";
 constexpr const char* kAdevColor = "#08519c";
 constexpr const char* kFitColor = "#d94801";
 
@@ -150,8 +150,8 @@ std::string ResidualPlot(const v1::CalibrationFitResult& fit, size_t poses,
     for (int i = 0; i < n; ++i) series.y.push_back(fit.residuals(i * k + s));
     p.series.push_back(series);
   }
-  plot::Series rms{"+RMS", kRmsColor, std::vector<double>(n, fit.residual_rms()), {}, {},
-                   {5, 3}, 1.0};
+  plot::Series rms{
+      "+RMS", kResidualRmsColor, std::vector<double>(n, fit.residual_rms()), {}, {}, {5, 3}, 1.0};
   plot::Series minus_rms = rms;
   minus_rms.label = "-RMS";
   for (double& v : minus_rms.y) v = -v;

@@ -26,6 +26,13 @@ inline constexpr size_t kMaxMessageTextBytes = 1500;
 // max_bytes, the first max_bytes bytes (cut at a character boundary) and " ... (N bytes)".
 std::string MessageText(std::string_view text, size_t max_bytes);
 
+// A number as SpecError messages show it: 17 significant digits (printf %.17g), which parse back
+// to the same double.
+std::string ValueText(double value);
+
+// "field[i]": the path of element i of a repeated field.
+std::string IndexedField(const std::string& field, size_t i);
+
 class SpecError : public std::runtime_error {
  public:
   // message: "<field>: <value> is not allowed; allowed: <range>".

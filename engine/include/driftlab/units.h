@@ -25,10 +25,15 @@
 #pragma once
 
 #include <cstddef>
+#include <numbers>
 #include <string>
 #include <string_view>
 
 namespace driftlab {
+
+// Degrees and radians: pi / 180 and its inverse, each rounded once to double.
+inline constexpr double kDegToRad = std::numbers::pi / 180.0;
+inline constexpr double kRadToDeg = 180.0 / std::numbers::pi;
 
 // Limits of a unit text (hostile input is bounded before the work; DESIGN.md invariant 10): its
 // length and the nesting of parentheses and square roots. Real units ("((deg/h)/sqrt(Hz))") use 2

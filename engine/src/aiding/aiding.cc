@@ -1,7 +1,6 @@
 #include "driftlab/aiding.h"
 
 #include <cmath>
-#include <cstdio>
 
 #include "driftlab/elementary.h"
 #include "driftlab/spec_error.h"
@@ -9,18 +8,13 @@
 namespace driftlab {
 namespace {
 
-std::string Num(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.17g", x);
-  return buf;
-}
-
 void CheckSigma(double value, const std::string& field, double max, const std::string& unit,
                 bool positive) {
   const bool ok = std::isfinite(value) && (positive ? value > 0.0 : value >= 0.0) && value <= max;
   if (!ok) {
-    throw SpecError(field, Num(value),
-                    std::string(positive ? "0 < " : "0 <= ") + "sigma <= " + Num(max) + " " + unit);
+    throw SpecError(
+        field, ValueText(value),
+        std::string(positive ? "0 < " : "0 <= ") + "sigma <= " + ValueText(max) + " " + unit);
   }
 }
 
@@ -28,13 +22,13 @@ void CheckSigma(double value, const std::string& field, double max, const std::s
 
 int64_t AidingDecimation(double rate_hz, double imu_rate_hz, const std::string& field) {
   if (!std::isfinite(rate_hz) || rate_hz <= 0.0 || rate_hz > imu_rate_hz) {
-    throw SpecError(field, Num(rate_hz),
-                    "0 < rate_hz <= " + Num(imu_rate_hz) + " Hz (not above the IMU rate)");
+    throw SpecError(field, ValueText(rate_hz),
+                    "0 < rate_hz <= " + ValueText(imu_rate_hz) + " Hz (not above the IMU rate)");
   }
   const double ratio = imu_rate_hz / rate_hz;
   if (std::abs(ratio - std::round(ratio)) > 1e-9 * ratio) {
-    throw SpecError(field, Num(rate_hz),
-                    "the IMU rate " + Num(imu_rate_hz) + " Hz divided by an integer");
+    throw SpecError(field, ValueText(rate_hz),
+                    "the IMU rate " + ValueText(imu_rate_hz) + " Hz divided by an integer");
   }
   return static_cast<int64_t>(std::llround(ratio));
 }
@@ -45,7 +39,7 @@ void ValidateBarometerConfig(const BarometerConfig& c, double imu_rate_hz,
   CheckSigma(c.noise_sigma_m, path + ".noise_sigma_m", 1000.0, "m", true);
   CheckSigma(c.bias.sigma, path + ".bias_gauss_markov_sigma_m", 1000.0, "m", false);
   if (c.bias.sigma > 0.0 && (!std::isfinite(c.bias.tau_s) || c.bias.tau_s <= 0.0)) {
-    throw SpecError(path + ".bias_gauss_markov_tau_s", Num(c.bias.tau_s),
+    throw SpecError(path + ".bias_gauss_markov_tau_s", ValueText(c.bias.tau_s),
                     "> 0 s when bias_gauss_markov_sigma_m > 0");
   }
 }
@@ -55,24 +49,25 @@ void ValidateMagnetometerConfig(const MagnetometerConfig& c, double imu_rate_hz,
   AidingDecimation(c.rate_hz, imu_rate_hz, path + ".rate_hz");
   if (!c.earth_field_n.allFinite() || c.earth_field_n.head<2>().norm() <= 0.0) {
     throw SpecError(path + ".earth_field_ned_ut",
-                    Num(c.earth_field_n.x()) + ", " + Num(c.earth_field_n.y()) + ", " +
-                        Num(c.earth_field_n.z()),
+                    ValueText(c.earth_field_n.x()) + ", " + ValueText(c.earth_field_n.y()) + ", " +
+                        ValueText(c.earth_field_n.z()),
                     "finite, with a non-zero horizontal part (north, east) to give a heading");
   }
   for (int i = 0; i < 3; ++i) {
     if (!std::isfinite(c.hard_iron_b[i])) {
-      throw SpecError(path + ".hard_iron_ut[" + std::to_string(i) + "]", Num(c.hard_iron_b[i]),
-                      "finite");
+      throw SpecError(path + ".hard_iron_ut[" + std::to_string(i) + "]",
+                      ValueText(c.hard_iron_b[i]), "finite");
     }
   }
   for (int i = 0; i < 9; ++i) {
     const double v = c.soft_iron(i / 3, i % 3);
     if (!std::isfinite(v) || std::abs(v) > 10.0) {
-      throw SpecError(path + ".soft_iron[" + std::to_string(i) + "]", Num(v), "-10 <= value <= 10");
+      throw SpecError(path + ".soft_iron[" + std::to_string(i) + "]", ValueText(v),
+                      "-10 <= value <= 10");
     }
   }
   if (!(std::abs(c.soft_iron.determinant()) > 1e-6)) {
-    throw SpecError(path + ".soft_iron", "determinant " + Num(c.soft_iron.determinant()),
+    throw SpecError(path + ".soft_iron", "determinant " + ValueText(c.soft_iron.determinant()),
                     "an invertible matrix (|det| > 1e-6)");
   }
   CheckSigma(c.noise_sigma, path + ".noise_sigma_ut", 1.0e4, "uT", false);
@@ -90,8 +85,8 @@ void ValidateAidingSpec(const AidingSpec& a, double imu_rate_hz, double duration
       const GnssOutage& o = a.gnss->outages[i];
       const double end_s = o.start_s + o.duration_s;
       if (end_s > duration_s * (1.0 + 1e-12)) {
-        throw SpecError("aiding.gnss.outages[" + std::to_string(i) + "].end_s", Num(end_s),
-                        "<= " + Num(duration_s) + " s (the trajectory's duration)");
+        throw SpecError("aiding.gnss.outages[" + std::to_string(i) + "].end_s", ValueText(end_s),
+                        "<= " + ValueText(duration_s) + " s (the trajectory's duration)");
       }
     }
   }

@@ -1,7 +1,6 @@
 #include "driftlab/gnss.h"
 
 #include <cmath>
-#include <cstdio>
 
 #include "driftlab/attitude.h"
 #include "driftlab/elementary.h"
@@ -10,16 +9,10 @@
 namespace driftlab {
 namespace {
 
-std::string Num(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.17g", x);
-  return buf;
-}
-
 void CheckSigmas(const Vector3d& s, const std::string& field) {
   for (int i = 0; i < 3; ++i) {
     if (!std::isfinite(s[i]) || s[i] < 0.0) {
-      throw SpecError(field + "[" + std::to_string(i) + "]", Num(s[i]), ">= 0 and finite");
+      throw SpecError(field + "[" + std::to_string(i) + "]", ValueText(s[i]), ">= 0 and finite");
     }
   }
 }
@@ -28,51 +21,52 @@ void CheckSigmas(const Vector3d& s, const std::string& field) {
 
 void ValidateGnssConfig(const GnssConfig& c, double imu_rate_hz, const std::string& path) {
   if (!std::isfinite(c.rate_hz) || c.rate_hz <= 0.0 || c.rate_hz > imu_rate_hz) {
-    throw SpecError(path + ".rate_hz", Num(c.rate_hz),
-                    "(0, " + Num(imu_rate_hz) + "] Hz (not above the IMU rate)");
+    throw SpecError(path + ".rate_hz", ValueText(c.rate_hz),
+                    "(0, " + ValueText(imu_rate_hz) + "] Hz (not above the IMU rate)");
   }
   const double ratio = imu_rate_hz / c.rate_hz;
   if (std::abs(ratio - std::round(ratio)) > 1e-9 * ratio) {
-    throw SpecError(path + ".rate_hz", Num(c.rate_hz),
-                    "IMU rate " + Num(imu_rate_hz) + " Hz divided by an integer");
+    throw SpecError(path + ".rate_hz", ValueText(c.rate_hz),
+                    "IMU rate " + ValueText(imu_rate_hz) + " Hz divided by an integer");
   }
   CheckSigmas(c.position_sigma_ned_m, path + ".position_sigma_ned_m");
   CheckSigmas(c.velocity_sigma_ned_m_per_s, path + ".velocity_sigma_ned_m_per_s");
   CheckSigmas(c.position_gauss_markov_sigma_ned_m, path + ".position_gauss_markov_sigma_ned_m");
   if (!c.position_gauss_markov_sigma_ned_m.isZero(0.0) &&
       (!std::isfinite(c.position_gauss_markov_tau_s) || c.position_gauss_markov_tau_s <= 0.0)) {
-    throw SpecError(path + ".position_gauss_markov_tau_s", Num(c.position_gauss_markov_tau_s),
+    throw SpecError(path + ".position_gauss_markov_tau_s", ValueText(c.position_gauss_markov_tau_s),
                     "> 0 s");
   }
   // The filter divides by these: a zero white sigma on a used measurement is singular.
   for (int i = 0; i < 3; ++i) {
     if (c.position_sigma_ned_m[i] + c.position_gauss_markov_sigma_ned_m[i] <= 0.0) {
       throw SpecError(path + ".position_sigma_ned_m[" + std::to_string(i) + "]",
-                      Num(c.position_sigma_ned_m[i]), "> 0 (with no correlated part)");
+                      ValueText(c.position_sigma_ned_m[i]), "> 0 (with no correlated part)");
     }
     if (c.use_velocity && c.velocity_sigma_ned_m_per_s[i] <= 0.0) {
       throw SpecError(path + ".velocity_sigma_ned_m_per_s[" + std::to_string(i) + "]",
-                      Num(c.velocity_sigma_ned_m_per_s[i]), "> 0 when use_velocity");
+                      ValueText(c.velocity_sigma_ned_m_per_s[i]), "> 0 when use_velocity");
     }
   }
   if (!c.lever_arm_b_m.allFinite() || c.lever_arm_b_m.norm() > 100.0) {
-    throw SpecError(path + ".lever_arm_b_m", Num(c.lever_arm_b_m.norm()) + " m", "<= 100 m");
+    throw SpecError(path + ".lever_arm_b_m", ValueText(c.lever_arm_b_m.norm()) + " m", "<= 100 m");
   }
   for (size_t i = 0; i < c.outages.size(); ++i) {
     const std::string f = path + ".outages[" + std::to_string(i) + "]";
     const GnssOutage& o = c.outages[i];
     if (!std::isfinite(o.start_s) || o.start_s < 0.0) {
-      throw SpecError(f + ".start_s", Num(o.start_s), ">= 0 s");
+      throw SpecError(f + ".start_s", ValueText(o.start_s), ">= 0 s");
     }
     if (!std::isfinite(o.duration_s) || o.duration_s <= 0.0) {
-      throw SpecError(f + ".duration_s", Num(o.duration_s), "> 0 s");
+      throw SpecError(f + ".duration_s", ValueText(o.duration_s), "> 0 s");
     }
     if (i > 0) {
       const GnssOutage& p = c.outages[i - 1];
       if (o.start_s < p.start_s + p.duration_s) {
-        throw SpecError(f + ".start_s", Num(o.start_s),
-                        ">= " + Num(p.start_s + p.duration_s) + " s (after the end of outages[" +
-                            std::to_string(i - 1) + "]; outages ascending and not overlapping)");
+        throw SpecError(f + ".start_s", ValueText(o.start_s),
+                        ">= " + ValueText(p.start_s + p.duration_s) +
+                            " s (after the end of outages[" + std::to_string(i - 1) +
+                            "]; outages ascending and not overlapping)");
       }
     }
   }

@@ -1,7 +1,6 @@
 #include "driftlab/complementary_filter.h"
 
 #include <cmath>
-#include <cstdio>
 #include <string>
 
 #include "driftlab/elementary.h"
@@ -9,12 +8,6 @@
 
 namespace driftlab {
 namespace {
-
-std::string Num(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof(buf), "%.17g", x);
-  return buf;
-}
 
 // Bilinear transform of the normalised analog section 1 / (p^2 + b p + 1) (low-pass) or
 // p^2 / (p^2 + b p + 1) (high-pass) with p = c (1 - z^-1) / (1 + z^-1), c = 1 / tan(w_c dt / 2)
@@ -109,11 +102,11 @@ ComplementaryPairDesign DesignComplementaryPair(ComplementaryPairKind kind, doub
                                                 double rate_hz, const std::string& crossover_field,
                                                 const std::string& rate_field) {
   if (!std::isfinite(rate_hz) || rate_hz <= 0.0) {
-    throw SpecError(rate_field, Num(rate_hz), "> 0 Hz");
+    throw SpecError(rate_field, ValueText(rate_hz), "> 0 Hz");
   }
   if (!std::isfinite(crossover_hz) || crossover_hz <= 0.0 || crossover_hz >= 0.5 * rate_hz) {
-    throw SpecError(crossover_field, Num(crossover_hz),
-                    "(0, " + Num(0.5 * rate_hz) + ") Hz (below the Nyquist frequency)");
+    throw SpecError(crossover_field, ValueText(crossover_hz),
+                    "(0, " + ValueText(0.5 * rate_hz) + ") Hz (below the Nyquist frequency)");
   }
   ComplementaryPairDesign d;
   d.kind = kind;
@@ -163,7 +156,7 @@ ComplementaryAttitudeFilter::ComplementaryAttitudeFilter(const ComplementaryFilt
   if (!std::isfinite(options.magnetic_declination_rad) ||
       std::abs(options.magnetic_declination_rad) > M_PI) {
     throw SpecError("complementary_filter.magnetic_declination_rad",
-                    Num(options.magnetic_declination_rad), "[-pi, pi] rad");
+                    ValueText(options.magnetic_declination_rad), "[-pi, pi] rad");
   }
   for (int axis = 0; axis < 3; ++axis) {
     const ComplementaryPairDesign& d = axis < 2 ? tilt_ : heading_;

@@ -13,15 +13,13 @@
 
 #include "driftlab/input_files.h"
 #include "driftlab/spec_error.h"
+#include "driftlab/units.h"
 
 namespace driftlab {
 
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
-constexpr double kRadToDeg = 180.0 / M_PI;
-
-std::string_view Trim(std::string_view s) {
+std::string_view TrimSpace(std::string_view s) {
   const char* spaces = " \t\r\n\f\v";
   const size_t b = s.find_first_not_of(spaces);
   if (b == std::string_view::npos) return {};
@@ -34,7 +32,7 @@ std::vector<std::string_view> SplitCsv(std::string_view line) {
   size_t start = 0;
   while (true) {
     const size_t comma = line.find(',', start);
-    fields.push_back(Trim(line.substr(
+    fields.push_back(TrimSpace(line.substr(
         start, comma == std::string_view::npos ? std::string_view::npos : comma - start)));
     if (comma == std::string_view::npos) break;
     start = comma + 1;
@@ -67,7 +65,7 @@ class CsvReader {
     std::string text;
     while (ReadLine(in_, &text, name_ + ":" + std::to_string(number_ + 1))) {
       ++number_;
-      if (Trim(text).empty()) continue;
+      if (TrimSpace(text).empty()) continue;
       line->number = number_;
       line->text = std::move(text);
       line->fields = SplitCsv(line->text);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
 
 namespace driftlab {
 namespace {
@@ -68,6 +69,16 @@ std::string MessageText(std::string_view text, size_t max_bytes) {
   }
   if (i < text.size()) out += " ... (" + std::to_string(text.size()) + " bytes)";
   return out;
+}
+
+std::string ValueText(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.17g", value);
+  return buffer;
+}
+
+std::string IndexedField(const std::string& field, size_t i) {
+  return field + "[" + std::to_string(i) + "]";
 }
 
 }  // namespace driftlab

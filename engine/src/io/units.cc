@@ -311,7 +311,7 @@ class UnitParser {
   int depth_ = 0;
 };
 
-std::string_view Trim(std::string_view s) {
+std::string_view TrimBlanks(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
   while (!s.empty() && (s.back() == ' ' || s.back() == '\t')) s.remove_suffix(1);
   return s;
@@ -381,13 +381,13 @@ constexpr std::string_view kAllSymbols =
 Unit ParseUnitOrThrow(std::string_view unit, std::string_view text, std::string_view field_path,
                       std::string_view allowed) {
   // A text too long to be a unit: say so first (an echo of it would be cut before the reason).
-  if (Trim(unit).size() > kMaxUnitTextBytes) {
+  if (TrimBlanks(unit).size() > kMaxUnitTextBytes) {
     throw SpecError(std::string(field_path),
-                    "a unit text of " + std::to_string(Trim(unit).size()) + " bytes",
+                    "a unit text of " + std::to_string(TrimBlanks(unit).size()) + " bytes",
                     "a unit text of at most " + std::to_string(kMaxUnitTextBytes) + " bytes");
   }
   try {
-    const Term t = UnitParser(Trim(unit)).Parse();
+    const Term t = UnitParser(TrimBlanks(unit)).Parse();
     return Unit{t.factor, t.dim};
   } catch (const UnitSyntaxError& e) {
     throw SpecError(std::string(field_path), "'" + std::string(text) + "' (" + e.reason + ")",
@@ -402,7 +402,7 @@ Unit ParseUnit(std::string_view unit, std::string_view field_path) {
 }
 
 Quantity ParseQuantity(std::string_view text, Dimension expected, std::string_view field_path) {
-  const std::string_view trimmed = Trim(text);
+  const std::string_view trimmed = TrimBlanks(text);
   const std::string allowed =
       "a number followed by a unit of " + DimensionName(expected) + ": " + AllowedUnits(expected);
   std::string_view rest = trimmed;
@@ -422,7 +422,7 @@ Quantity ParseQuantity(std::string_view text, Dimension expected, std::string_vi
   if (negative) value = -value;
   Quantity q;
   q.value = value;
-  q.unit = std::string(Trim(rest.substr(static_cast<size_t>(end - rest.data()))));
+  q.unit = std::string(TrimBlanks(rest.substr(static_cast<size_t>(end - rest.data()))));
   if (q.unit.empty() && expected != dims::kDimensionless) {
     throw SpecError(std::string(field_path), "'" + std::string(text) + "' (missing unit)", allowed);
   }
@@ -452,7 +452,7 @@ std::string FormatQuantity(double value_si, std::string_view unit, int precision
                                                     std::chars_format::general, precision)
                                     : std::to_chars(buf.data(), buf.data() + buf.size(), value);
   std::string out(buf.data(), result.ptr);
-  const std::string_view u = Trim(unit);
+  const std::string_view u = TrimBlanks(unit);
   if (!u.empty()) {
     out += " ";
     out += u;

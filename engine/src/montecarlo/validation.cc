@@ -20,17 +20,6 @@ namespace mc_detail {
 
 namespace {
 
-std::string Num(double v) {
-  std::ostringstream os;
-  os.precision(17);
-  os << v;
-  return os.str();
-}
-
-std::string Indexed(const std::string& field, size_t i) {
-  return field + "[" + std::to_string(i) + "]";
-}
-
 // Converts requested times into ascending sample indices in [first_k, n].
 std::vector<int64_t> SnapTimes(const std::vector<double>& times_s, const std::string& field,
                                int64_t first_k, int64_t n, double dt_s) {
@@ -38,18 +27,18 @@ std::vector<int64_t> SnapTimes(const std::vector<double>& times_s, const std::st
   const double t_min = static_cast<double>(first_k) * dt_s;
   const double t_max = static_cast<double>(n) * dt_s;
   const double slack = 0.5 * dt_s;
-  const std::string allowed = "[" + Num(t_min) + ", " + Num(t_max) +
+  const std::string allowed = "[" + ValueText(t_min) + ", " + ValueText(t_max) +
                               "] s (navigation start to trajectory end), strictly ascending";
   for (size_t i = 0; i < times_s.size(); ++i) {
     const double t = times_s[i];
     if (!std::isfinite(t) || t < t_min - slack || t > t_max + slack) {
-      throw SpecError(Indexed(field, i), Num(t), allowed);
+      throw SpecError(IndexedField(field, i), ValueText(t), allowed);
     }
     const int64_t k = std::clamp<int64_t>(std::llround(t / dt_s), first_k, n);
     if (!out.empty() && k <= out.back()) {
       throw SpecError(
-          Indexed(field, i), Num(t),
-          allowed + " after snapping to the IMU sample grid (dt = " + Num(dt_s) + " s)");
+          IndexedField(field, i), ValueText(t),
+          allowed + " after snapping to the IMU sample grid (dt = " + ValueText(dt_s) + " s)");
     }
     out.push_back(k);
   }
@@ -68,7 +57,7 @@ std::string Gigabytes(uint64_t bytes) {
 void ValidateSigmas(const Eigen::Vector3d& v, const std::string& field, const std::string& unit) {
   for (int i = 0; i < 3; ++i) {
     if (!std::isfinite(v[i]) || v[i] < 0.0) {
-      throw SpecError(Indexed(field, static_cast<size_t>(i)), Num(v[i]),
+      throw SpecError(IndexedField(field, static_cast<size_t>(i)), ValueText(v[i]),
                       "a finite 1-sigma >= 0 [" + unit + "]");
     }
   }
@@ -231,12 +220,12 @@ void ValidateSpec(const MonteCarloSpec& spec) {
   if (!seed000 && spec.initialization == InitializationKind::kStaticAlignment) {
     const AlignmentOptions& a = spec.alignment;
     if (!std::isfinite(a.duration_s) || a.duration_s <= 0.0) {
-      throw SpecError("monte_carlo.alignment.duration_s", Num(a.duration_s),
+      throw SpecError("monte_carlo.alignment.duration_s", ValueText(a.duration_s),
                       "a finite duration > 0 [s]");
     }
     if (a.heading_sigma_rad &&
         (!std::isfinite(*a.heading_sigma_rad) || *a.heading_sigma_rad <= 0.0)) {
-      throw SpecError("monte_carlo.alignment.heading_sigma_rad", Num(*a.heading_sigma_rad),
+      throw SpecError("monte_carlo.alignment.heading_sigma_rad", ValueText(*a.heading_sigma_rad),
                       "a finite 1-sigma > 0 [rad], or absent (always gyrocompass)");
     }
     if (!spec.initial_errors.attitude_rad.isZero(0.0)) {
@@ -258,16 +247,17 @@ JobPlan PlanJob(const MonteCarloSpec& spec, const TrajectoryGenerator& generator
   if (seed000) {
     const double T = spec.simulation.seed000.static_period_s;
     if (T > generator.duration_s()) {
-      throw SpecError("navigation.seed000.static_period_s", Num(T),
-                      "at most the motion's duration (" + Num(generator.duration_s()) + " s)");
+      throw SpecError(
+          "navigation.seed000.static_period_s", ValueText(T),
+          "at most the motion's duration (" + ValueText(generator.duration_s()) + " s)");
     }
     plan.start_step = std::llround(T / dt_s);  // Seed000Options: N = round(T / dt)
   } else if (spec.initialization == InitializationKind::kStaticAlignment) {
     const double T = spec.alignment.duration_s;
     plan.start_step = std::llround(T / dt_s);
     if (plan.start_step < 1 || plan.start_step > plan.n) {
-      throw SpecError("monte_carlo.alignment.duration_s", Num(T),
-                      "[" + Num(dt_s) + ", " + Num(generator.duration_s()) +
+      throw SpecError("monte_carlo.alignment.duration_s", ValueText(T),
+                      "[" + ValueText(dt_s) + ", " + ValueText(generator.duration_s()) +
                           "] s (at least one IMU sample, at most the trajectory)");
     }
     // Static at every sample of the window and at every kink inside it.
@@ -279,9 +269,9 @@ JobPlan PlanJob(const MonteCarloSpec& spec, const TrajectoryGenerator& generator
       if (t <= static_cast<double>(plan.start_step) * dt_s) is_static &= generator.IsStaticAt(t);
     }
     if (!is_static) {
-      throw SpecError("monte_carlo.alignment.duration_s", Num(T),
+      throw SpecError("monte_carlo.alignment.duration_s", ValueText(T),
                       "a window over which the trajectory is static (the vehicle moves before " +
-                          Num(static_cast<double>(plan.start_step) * dt_s) + " s)");
+                          ValueText(static_cast<double>(plan.start_step) * dt_s) + " s)");
     }
     if (!spec.alignment.heading_sigma_rad && generator.environment().model() == EarthModel::kFlat) {
       throw SpecError("monte_carlo.alignment.heading_sigma_rad", "",

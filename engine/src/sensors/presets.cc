@@ -34,14 +34,14 @@ ImuErrorModel GnssInsSimAccuracy(const char* level, double gyro_drift_deg_per_h,
       std::string("gnss-ins-sim's built-in '") + level +
       "-accuracy' IMU (source code: gnss_ins_sim/sim/imu_model.py, github.com/Aceinna/"
       "gnss-ins-sim commit 966ff27, gyro_/accel_" +
-      level + "_accuracy). Gyro: Gauss-Markov bias sigma " + Num(gyro_drift_deg_per_h) +
+      level + "_accuracy). Gyro: Gauss-Markov bias sigma " + ShortestText(gyro_drift_deg_per_h) +
       " deg/h, tau 100 s, starting at 0 in each run as gnss-ins-sim does (pathgen.bias_drift); "
       "ARW " +
-      Num(arw_deg_per_sqrt_h) +
+      ShortestText(arw_deg_per_sqrt_h) +
       " deg/sqrt(h); constant bias 0. Accel: Gauss-Markov "
       "bias sigma " +
-      Num(accel_drift_m_per_s2) + " m/s^2, tau 100 s, starting at 0; VRW " +
-      Num(vrw_m_per_s_per_sqrt_h) +
+      ShortestText(accel_drift_m_per_s2) + " m/s^2, tau 100 s, starting at 0; VRW " +
+      ShortestText(vrw_m_per_s_per_sqrt_h) +
       " m/s/sqrt(h); constant bias 0. Assumed: nothing else "
       "(gnss-ins-sim models no turn-on bias, scale factor, misalignment, random walk, "
       "quantization or range; all off here).";

@@ -14,7 +14,7 @@
 
 namespace driftlab::presets {
 inline constexpr double kPi = std::numbers::pi;
-inline constexpr double kG = kStandardGravity_m_per_s2;  // 1 g = 9.80665 m/s^2 (CGPM 1901)
+inline constexpr double kG_m_per_s2 = kStandardGravity_m_per_s2;  // 1 g = 9.80665 m/s^2 (CGPM 1901)
 
 // Angle: 1 deg = pi / 180 rad.
 constexpr double Deg(double deg) { return deg * kPi / 180.0; }
@@ -28,11 +28,11 @@ constexpr double DegPerH(double deg_per_h) { return Deg(deg_per_h) / 3600.0; }
 constexpr double DegPerSqrtH(double deg_per_sqrt_h) { return Deg(deg_per_sqrt_h) / 60.0; }
 // Rate noise density: 1 (deg/s)/sqrt(Hz) = 1 deg/sqrt(s) = pi / 180 rad/sqrt(s) (seed 001).
 constexpr double DegPerSPerSqrtHz(double v) { return Deg(v); }
-// Specific force: 1 g = kG m/s^2; 1 mg = 1e-3 kG; 1 ug = 1e-6 kG.
-constexpr double Gee(double g) { return g * kG; }
-constexpr double MilliG(double mg) { return mg * 1e-3 * kG; }
-constexpr double MicroG(double ug) { return ug * 1e-6 * kG; }
-// Accelerometer noise density: 1 ug/sqrt(Hz) = 1e-6 kG (m/s^2)/sqrt(Hz) = 1e-6 kG m/s/sqrt(s).
+// Specific force: 1 g = 9.80665 m/s^2; 1 mg = 1e-3 g; 1 ug = 1e-6 g.
+constexpr double Gee(double g) { return g * kG_m_per_s2; }
+constexpr double MilliG(double mg) { return mg * 1e-3 * kG_m_per_s2; }
+constexpr double MicroG(double ug) { return ug * 1e-6 * kG_m_per_s2; }
+// Accelerometer noise density: 1 ug/sqrt(Hz) = 1e-6 g (m/s^2)/sqrt(Hz) = 1e-6 g m/s/sqrt(s).
 constexpr double MicroGPerSqrtHz(double v) { return MicroG(v); }
 constexpr double MilliGPerSqrtHz(double v) { return MilliG(v); }
 // Velocity random walk: 1 m/s/sqrt(h) = 1 m/s / sqrt(3600 s) = 1/60 m/s/sqrt(s) = (m/s^2)/sqrt(Hz).
@@ -42,12 +42,12 @@ constexpr double FtPerSPerSqrtH(double v) { return v * 0.3048 / 60.0; }
 // Ratios: 1 ppm = 1e-6; 1 % = 1e-2.
 constexpr double Ppm(double ppm) { return ppm * 1e-6; }
 constexpr double Percent(double percent) { return percent * 1e-2; }
-// Gyro g-sensitivity: 1 (deg/s)/g = (pi / 180) / kG (rad/s)/(m/s^2); likewise for (deg/h)/g.
-constexpr double DegPerSPerG(double v) { return DegPerS(v) / kG; }
-constexpr double DegPerHPerG(double v) { return DegPerH(v) / kG; }
+// Gyro g-sensitivity: 1 (deg/s)/g = (pi / 180) / 9.80665 (rad/s)/(m/s^2); likewise for (deg/h)/g.
+constexpr double DegPerSPerG(double v) { return DegPerS(v) / kG_m_per_s2; }
+constexpr double DegPerHPerG(double v) { return DegPerH(v) / kG_m_per_s2; }
 
 // Shortest decimal text of a datasheet figure, for descriptions ("3.5", "0.0002").
-inline std::string Num(double x) {
+inline std::string ShortestText(double x) {
   char buffer[32];
   const auto result = std::to_chars(buffer, buffer + sizeof(buffer), x);
   return std::string(buffer, result.ptr);

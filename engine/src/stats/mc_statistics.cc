@@ -17,10 +17,6 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-std::string Indexed(const std::string& field, size_t i) {
-  return field + "[" + std::to_string(i) + "]";
-}
-
 std::string RangesText(const std::vector<RunRange>& runs) {
   std::string s;
   for (const RunRange& r : runs) {
@@ -111,7 +107,7 @@ MonteCarloStatistics::MonteCarloStatistics(MonteCarloStatisticsData data, const 
     const bool ordered =
         r.first < r.end && r.end <= d.job_runs && (i == 0 || d.runs[i - 1].end <= r.first);
     if (!ordered) {
-      throw SpecError(Indexed(field + ".runs", i),
+      throw SpecError(IndexedField(field + ".runs", i),
                       "[" + std::to_string(r.first) + ", " + std::to_string(r.end) + ")",
                       "non-empty ranges, ascending and disjoint, within [0, " +
                           std::to_string(d.job_runs) + ")");
@@ -122,7 +118,7 @@ MonteCarloStatistics::MonteCarloStatistics(MonteCarloStatisticsData data, const 
   for (size_t i = 0; i < d.epoch_times_s.size(); ++i) {
     if (!std::isfinite(d.epoch_times_s[i]) ||
         (i > 0 && d.epoch_times_s[i] <= d.epoch_times_s[i - 1])) {
-      throw SpecError(Indexed(field + ".epoch_times_s", i), std::to_string(d.epoch_times_s[i]),
+      throw SpecError(IndexedField(field + ".epoch_times_s", i), std::to_string(d.epoch_times_s[i]),
                       "finite and strictly ascending times [s]");
     }
   }
@@ -132,7 +128,7 @@ MonteCarloStatistics::MonteCarloStatistics(MonteCarloStatisticsData data, const 
   }
   for (size_t c = 0; c < d.checkpoints.size(); ++c) {
     const CheckpointValues& cp = d.checkpoints[c];
-    const std::string path = Indexed(field + ".checkpoints", c);
+    const std::string path = IndexedField(field + ".checkpoints", c);
     if (!std::isfinite(cp.t_s) || (c > 0 && cp.t_s <= d.checkpoints[c - 1].t_s)) {
       throw SpecError(path + ".t_s", std::to_string(cp.t_s), "finite and strictly ascending [s]");
     }
@@ -146,7 +142,7 @@ MonteCarloStatistics::MonteCarloStatistics(MonteCarloStatisticsData data, const 
       for (uint32_t run = r.first; run < r.end; ++run, ++k) {
         if (cp.run_index[k] != run) {
           throw SpecError(
-              Indexed(path + ".run_index", k), std::to_string(cp.run_index[k]),
+              IndexedField(path + ".run_index", k), std::to_string(cp.run_index[k]),
               std::to_string(run) + " (the runs " + RangesText(data_.runs) + ", ascending)");
         }
       }
@@ -186,7 +182,7 @@ void MonteCarloStatistics::Merge(const MonteCarloStatistics& other) {
   }
   for (size_t c = 0; c < d.checkpoints.size(); ++c) {
     if (o.checkpoints[c].t_s != d.checkpoints[c].t_s) {
-      throw SpecError(Indexed("statistics.checkpoints", c) + ".t_s",
+      throw SpecError(IndexedField("statistics.checkpoints", c) + ".t_s",
                       std::to_string(o.checkpoints[c].t_s),
                       std::to_string(d.checkpoints[c].t_s) + " (same checkpoints in every shard)");
     }

@@ -24,12 +24,12 @@
 
 #include "driftlab/elementary.h"
 #include "driftlab/spec_error.h"
+#include "driftlab/units.h"
 
 namespace driftlab {
 
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 constexpr double kDynamicSubstep_s = 0.01;
 constexpr double kUniformSubstep_s = 1.0;
 // WGS-84 navigation is limited to |L| < 89.9 deg: tan L and 1 / cos L in the transport rate and the
@@ -41,7 +41,7 @@ constexpr double kMaxHeight_m = 1.0e5;
 constexpr double kMaxSpeed_m_per_s = 1.0e4;
 
 // Shortest text that parses back to the same double ("nan", "inf" for the non-finite).
-std::string Num(double x) {
+std::string CompactText(double x) {
   if (std::isnan(x)) return "nan";
   if (std::isinf(x)) return x > 0 ? "inf" : "-inf";
   if (x == std::trunc(x) && std::abs(x) < 1e15) return std::to_string(static_cast<int64_t>(x));
@@ -51,7 +51,7 @@ std::string Num(double x) {
 }
 
 [[noreturn]] void Reject(const std::string& field, double value, const std::string& allowed) {
-  throw SpecError(field, Num(value), allowed);
+  throw SpecError(field, CompactText(value), allowed);
 }
 [[noreturn]] void RejectText(const std::string& field, const std::string& message) {
   throw SpecError(field, message, 0);
@@ -63,7 +63,8 @@ void CheckFinite(const std::string& field, double value) {
 // 0 < value <= hi.
 void CheckPositive(const std::string& field, double value, double hi, const std::string& unit) {
   if (!(value > 0.0 && value <= hi)) {
-    Reject(field, value, "0 < " + field.substr(field.rfind('.') + 1) + " <= " + Num(hi) + unit);
+    Reject(field, value,
+           "0 < " + field.substr(field.rfind('.') + 1) + " <= " + CompactText(hi) + unit);
   }
 }
 void CheckDuration(const std::string& field, double value) {
@@ -72,7 +73,8 @@ void CheckDuration(const std::string& field, double value) {
 // 0 <= value <= hi.
 void CheckNonNegative(const std::string& field, double value, double hi, const std::string& unit) {
   if (!(value >= 0.0 && value <= hi)) {
-    Reject(field, value, "0 <= " + field.substr(field.rfind('.') + 1) + " <= " + Num(hi) + unit);
+    Reject(field, value,
+           "0 <= " + field.substr(field.rfind('.') + 1) + " <= " + CompactText(hi) + unit);
   }
 }
 
@@ -404,7 +406,7 @@ class Planner {
 
   void CheckFlightPath(const std::string& path, double V_min, double v_down) const {
     if (motion_.vehicle.pitch_follows_flight_path && V_min == 0.0 && v_down != 0.0) {
-      RejectText(path, "vertical speed " + Num(-v_down) +
+      RejectText(path, "vertical speed " + CompactText(-v_down) +
                            " m/s at zero ground speed; allowed: ground speed > 0 whenever the "
                            "vertical speed is non-zero (vehicle.pitch_follows_flight_path: the "
                            "flight-path angle would jump to +-90 deg)");
@@ -416,7 +418,7 @@ class Planner {
     const double speed = state_.v_eb_n.norm();
     if (speed != 0.0) {
       RejectText(path + ".static",
-                 "speed " + Num(speed) +
+                 "speed " + CompactText(speed) +
                      " m/s at the segment's start is not allowed; allowed: 0 (a static segment "
                      "must start at rest)");
     }
@@ -453,13 +455,13 @@ class Planner {
       }
       if (target == V) {
         Reject(base + ".target_speed_m_per_s", target,
-               "a speed different from the current ground speed " + Num(V) + " m/s");
+               "a speed different from the current ground speed " + CompactText(V) + " m/s");
       }
       V_end = target;
       T = std::abs(target - V) / s.acceleration_m_per_s2;
       if (!(T <= kMaxDuration_s)) {
         Reject(base + ".target_speed_m_per_s", target,
-               "reachable within " + Num(kMaxDuration_s) + " s at the given acceleration");
+               "reachable within " + CompactText(kMaxDuration_s) + " s at the given acceleration");
       }
     } else {
       T = *s.duration_s;
@@ -468,12 +470,12 @@ class Planner {
       V_end = V + sign * s.acceleration_m_per_s2 * T;
       if (V_end < 0.0) {
         Reject(base + ".duration_s", T,
-               "0 < duration_s <= " + Num(V / s.acceleration_m_per_s2) + " s (decelerating from " +
-                   Num(V) + " m/s must not reverse)");
+               "0 < duration_s <= " + CompactText(V / s.acceleration_m_per_s2) +
+                   " s (decelerating from " + CompactText(V) + " m/s must not reverse)");
       }
       if (V_end > kMaxSpeed_m_per_s) {
         Reject(base + ".duration_s", T,
-               "a duration that keeps the speed <= " + Num(kMaxSpeed_m_per_s) + " m/s");
+               "a duration that keeps the speed <= " + CompactText(kMaxSpeed_m_per_s) + " m/s");
       }
     }
     CheckFlightPath(base, std::min(V, V_end), vD);
@@ -544,7 +546,8 @@ class Planner {
       hold = angle / std::abs(omega) - Tr;
       if (hold < 0.0) {
         Reject(base + ".angle_deg", angle * kRadToDeg,
-               "angle_deg >= |rate| x transition_s = " + Num(std::abs(omega) * Tr * kRadToDeg) +
+               "angle_deg >= |rate| x transition_s = " +
+                   CompactText(std::abs(omega) * Tr * kRadToDeg) +
                    " deg (the ramps alone turn that much)");
       }
     } else {
@@ -552,7 +555,7 @@ class Planner {
       hold = *s.duration_s - 2.0 * Tr;
       if (hold < 0.0) {
         Reject(base + ".duration_s", *s.duration_s,
-               "duration_s >= 2 x transition_s = " + Num(2.0 * Tr) + " s");
+               "duration_s >= 2 x transition_s = " + CompactText(2.0 * Tr) + " s");
       }
     }
     CheckFlightPath(base, V, vD);
@@ -564,8 +567,8 @@ class Planner {
     const double c = s.climb_rate_m_per_s;
     if (!(std::isfinite(c) && c != 0.0 && std::abs(c) <= kMaxSpeed_m_per_s)) {
       Reject(base + ".climb_rate_m_per_s", c,
-             "-" + Num(kMaxSpeed_m_per_s) + " <= climb_rate_m_per_s <= " + Num(kMaxSpeed_m_per_s) +
-                 " m/s, not 0");
+             "-" + CompactText(kMaxSpeed_m_per_s) +
+                 " <= climb_rate_m_per_s <= " + CompactText(kMaxSpeed_m_per_s) + " m/s, not 0");
     }
     const double a = s.vertical_acceleration_m_per_s2;
     CheckPositive(base + ".vertical_acceleration_m_per_s2", a, 1000.0, " m/s^2");
@@ -587,14 +590,14 @@ class Planner {
       const double dh = *s.height_change_m;
       if (!(std::isfinite(dh) && dh != 0.0 && (dh > 0.0) == (c > 0.0))) {
         Reject(base + ".height_change_m", dh,
-               "a finite non-zero height change with the sign of climb_rate_m_per_s (" + Num(c) +
-                   " m/s)");
+               "a finite non-zero height change with the sign of climb_rate_m_per_s (" +
+                   CompactText(c) + " m/s)");
       }
       // Height change = (v0 + c) Tr  (two ramps) + c hold.
       hold = (dh - (v0 + c) * Tr) / c;
       if (hold < 0.0) {
         Reject(base + ".height_change_m", dh,
-               "|height_change_m| >= " + Num(std::abs((v0 + c) * Tr)) +
+               "|height_change_m| >= " + CompactText(std::abs((v0 + c) * Tr)) +
                    " m (the height changed during the two vertical-speed ramps)");
       }
     } else {
@@ -603,7 +606,7 @@ class Planner {
       if (hold < 0.0) {
         Reject(base + ".duration_s", *s.duration_s,
                "duration_s >= 2 |climb_rate - vertical speed| / vertical_acceleration = " +
-                   Num(2.0 * Tr) + " s");
+                   CompactText(2.0 * Tr) + " s");
       }
     }
     const TrackPiece shape = TrackTemplate(V, chi, vD, 0.0);
@@ -642,7 +645,7 @@ class Planner {
     const double A = 2.0 * M_PI * s.amplitude_m / (V * s.period_s);
     if (A > 0.5 * M_PI) {
       Reject(base + ".amplitude_m", s.amplitude_m,
-             "0 < amplitude_m <= speed x period_s / 4 = " + Num(V * s.period_s / 4.0) +
+             "0 < amplitude_m <= speed x period_s / 4 = " + CompactText(V * s.period_s / 4.0) +
                  " m (heading amplitude at most 90 deg)");
     }
     CheckFlightPath(base, V, vD);
@@ -658,9 +661,9 @@ class Planner {
     const double min_period_s = kMinSamplesPerPeriod * dt_s_;
     if (period_s < min_period_s) {
       Reject(field, period_s,
-             field.substr(field.rfind('.') + 1) + " >= " + Num(min_period_s) + " s (" +
-                 Num(kMinSamplesPerPeriod) + " output intervals at rate_hz " + Num(rate_hz_) +
-                 " Hz; the Nyquist limit is 2)");
+             field.substr(field.rfind('.') + 1) + " >= " + CompactText(min_period_s) + " s (" +
+                 CompactText(kMinSamplesPerPeriod) + " output intervals at rate_hz " +
+                 CompactText(rate_hz_) + " Hz; the Nyquist limit is 2)");
     }
   }
 
@@ -688,7 +691,7 @@ class Planner {
       if (!(c.amplitude >= 0.0 && c.amplitude <= c.max_amplitude)) {
         Reject(amplitude_field, c.amplitude * c.scale,
                "0 <= " + amplitude_field.substr(amplitude_field.rfind('.') + 1) +
-                   " <= " + Num(c.max_amplitude * c.scale) + c.unit);
+                   " <= " + CompactText(c.max_amplitude * c.scale) + c.unit);
       }
       CheckPositive(name + "_period_s", c.period, kMaxDuration_s, " s");
       if (c.amplitude > 0.0) CheckSampledPeriod(name + "_period_s", c.period);
@@ -701,9 +704,10 @@ class Planner {
     const double R = s.ramp_s > 0.0 ? s.ramp_s : longest;
     if (R > 0.5 * s.duration_s) {
       Reject(base + ".ramp_s", s.ramp_s,
-             "ramp_s <= duration_s / 2 = " + Num(0.5 * s.duration_s) + " s" +
-                 (s.ramp_s > 0.0 ? std::string()
-                                 : " (ramp_s = 0 means the longest period, " + Num(R) + " s)"));
+             "ramp_s <= duration_s / 2 = " + CompactText(0.5 * s.duration_s) + " s" +
+                 (s.ramp_s > 0.0
+                      ? std::string()
+                      : " (ramp_s = 0 means the longest period, " + CompactText(R) + " s)"));
     }
     double V, chi, vD;
     TrackStart(&V, &chi, &vD);
@@ -784,7 +788,7 @@ class Planner {
     const double hold = 2.0 * M_PI / omega - Tr;
     if (hold < 0.0) {
       Reject(base + ".transition_s", Tr,
-             "transition_s <= 2 pi / rate = " + Num(2.0 * M_PI / omega) + " s");
+             "transition_s <= 2 pi / rate = " + CompactText(2.0 * M_PI / omega) + " s");
     }
     CheckFlightPath(base, V, vD);
     for (int loop = 0; loop < s.loops; ++loop) {
@@ -925,20 +929,21 @@ class Planner {
         if (!(std::abs(cmd.euler_ypr(i)) <= kMaxCommandRate_rad_per_s)) {
           Reject(field(angle_names[i]), cmd.euler_ypr(i) * kRadToDeg,
                  std::string("|") + angle_names[i] +
-                     " rate| <= " + Num(kMaxCommandRate_rad_per_s * kRadToDeg) +
+                     " rate| <= " + CompactText(kMaxCommandRate_rad_per_s * kRadToDeg) +
                      " deg/s (100 rad/s) in a type-1 command");
         }
         if (!(std::abs(cmd.v_b(i)) <= kMaxCommandAcceleration_m_per_s2)) {
           Reject(field(velocity_names[i]), cmd.v_b(i),
                  std::string("|") + velocity_names[i] + " acceleration| <= " +
-                     Num(kMaxCommandAcceleration_m_per_s2) + " m/s^2 in a type-1 command");
+                     CompactText(kMaxCommandAcceleration_m_per_s2) + " m/s^2 in a type-1 command");
         }
       }
     }
     const std::string duration_field = field("duration_s");
     // 0 is allowed: gnss-ins-sim then takes no step (round(duration * rate) = 0).
     if (!(cmd.duration_s >= 0.0 && cmd.duration_s <= kMaxDuration_s)) {
-      Reject(duration_field, cmd.duration_s, "0 <= duration_s <= " + Num(kMaxDuration_s) + " s");
+      Reject(duration_field, cmd.duration_s,
+             "0 <= duration_s <= " + CompactText(kMaxDuration_s) + " s");
     }
 
     Executor& x = exec_;
@@ -992,7 +997,7 @@ class Planner {
     }
     if (!(x.v_b.norm() <= kMaxSpeed_m_per_s)) {
       Reject(field(cmd.type == 1 ? "vx_body" : "duration_s"), x.v_b.norm(),
-             "a command ending at a speed <= " + Num(kMaxSpeed_m_per_s) +
+             "a command ending at a speed <= " + CompactText(kMaxSpeed_m_per_s) +
                  " m/s (the speed it reaches)");
     }
   }
@@ -1115,7 +1120,7 @@ void PlanTruthProfile(const MotionSpec& motion, std::vector<Piece>* pieces) {
     for (int j = 0; j < 10; ++j) CheckFinite(at + names[j], values[j]);
     if (i > 0 && !(p.t_s > samples[i - 1].t_s)) {
       Reject(at + ".t_s", p.t_s,
-             "a time greater than the previous sample's " + Num(samples[i - 1].t_s) + " s");
+             "a time greater than the previous sample's " + CompactText(samples[i - 1].t_s) + " s");
     }
     t[i] = p.t_s - samples[0].t_s;
     channels[0][i] = p.v_eb_n.x();
@@ -1131,7 +1136,7 @@ void PlanTruthProfile(const MotionSpec& motion, std::vector<Piece>* pieces) {
   }
   if (t[n - 1] > kMaxDuration_s) {
     Reject(base + "[" + std::to_string(n - 1) + "].t_s", samples[n - 1].t_s,
-           "a profile lasting at most " + Num(kMaxDuration_s) + " s");
+           "a profile lasting at most " + CompactText(kMaxDuration_s) + " s");
   }
   std::vector<std::vector<double>> slopes;
   for (const auto& y : channels) slopes.push_back(NotAKnotSlopes(t, y));
@@ -1172,13 +1177,14 @@ void ValidateLlh(const std::string& path, const Llh& llh, EarthModel model) {
   }
   if (!(llh.h_m >= kMinHeight_m && llh.h_m <= kMaxHeight_m)) {
     Reject(path + ".height_m", llh.h_m,
-           Num(kMinHeight_m) + " <= height_m <= " + Num(kMaxHeight_m) + " m");
+           CompactText(kMinHeight_m) + " <= height_m <= " + CompactText(kMaxHeight_m) + " m");
   }
 }
 
 void ValidateMotionHeader(const MotionSpec& motion, double rate_hz) {
   if (!(rate_hz >= kMinRate_hz && rate_hz <= kMaxRate_hz)) {
-    Reject("rate_hz", rate_hz, Num(kMinRate_hz) + " <= rate_hz <= " + Num(kMaxRate_hz) + " Hz");
+    Reject("rate_hz", rate_hz,
+           CompactText(kMinRate_hz) + " <= rate_hz <= " + CompactText(kMaxRate_hz) + " Hz");
   }
   const std::string& m = motion.field_path;
   if (motion.flat_gravity_m_per_s2) {
@@ -1207,7 +1213,7 @@ void ValidateMotionHeader(const MotionSpec& motion, double rate_hz) {
   for (int i = 0; i < 3; ++i) CheckFinite(init + v_names[i], motion.initial.v_eb_n(i));
   if (!(motion.initial.v_eb_n.norm() <= kMaxSpeed_m_per_s)) {
     Reject(init + ".velocity_ned_m_per_s", motion.initial.v_eb_n.norm(),
-           "speed <= " + Num(kMaxSpeed_m_per_s) + " m/s");
+           "speed <= " + CompactText(kMaxSpeed_m_per_s) + " m/s");
   }
   const EulerAngles& a = motion.initial.attitude;
   if (!(std::abs(a.roll_rad) <= 2.0 * M_PI)) {
@@ -1226,11 +1232,12 @@ void ValidateMotionHeader(const MotionSpec& motion, double rate_hz) {
         lim.max_angular_acceleration_rad_per_s2 <= 1000.0)) {
     Reject(g + ".max_angular_acceleration_deg_per_s2",
            lim.max_angular_acceleration_rad_per_s2 * kRadToDeg,
-           "0 < max_angular_acceleration_deg_per_s2 <= " + Num(1000.0 * kRadToDeg) + " deg/s^2");
+           "0 < max_angular_acceleration_deg_per_s2 <= " + CompactText(1000.0 * kRadToDeg) +
+               " deg/s^2");
   }
   if (!(lim.max_angular_rate_rad_per_s > 0.0 && lim.max_angular_rate_rad_per_s <= 100.0)) {
     Reject(g + ".max_angular_rate_deg_per_s", lim.max_angular_rate_rad_per_s * kRadToDeg,
-           "0 < max_angular_rate_deg_per_s <= " + Num(100.0 * kRadToDeg) + " deg/s");
+           "0 < max_angular_rate_deg_per_s <= " + CompactText(100.0 * kRadToDeg) + " deg/s");
   }
 }
 
@@ -1400,14 +1407,15 @@ struct TrajectoryGenerator::Impl {
   void CheckPosition(double t) const {
     if (env.model() == EarthModel::kWgs84 &&
         std::abs(llh.x()) * kRadToDeg >= kMaxWgs84Latitude_deg) {
-      RejectText(field_path, "the trajectory reaches latitude " + Num(llh.x() * kRadToDeg) +
-                                 " deg at t = " + Num(t) +
+      RejectText(field_path, "the trajectory reaches latitude " + CompactText(llh.x() * kRadToDeg) +
+                                 " deg at t = " + CompactText(t) +
                                  " s; allowed: |lat| < 89.9 deg on WGS-84");
     }
     if (!(llh.z() >= kMinHeight_m && llh.z() <= kMaxHeight_m)) {
-      RejectText(field_path, "the trajectory reaches height " + Num(llh.z()) +
-                                 " m at t = " + Num(t) + " s; allowed: " + Num(kMinHeight_m) +
-                                 " <= h <= " + Num(kMaxHeight_m) + " m");
+      RejectText(field_path, "the trajectory reaches height " + CompactText(llh.z()) +
+                                 " m at t = " + CompactText(t) +
+                                 " s; allowed: " + CompactText(kMinHeight_m) +
+                                 " <= h <= " + CompactText(kMaxHeight_m) + " m");
     }
   }
 };
@@ -1445,12 +1453,13 @@ TrajectoryGenerator::TrajectoryGenerator(const MotionSpec& motion, double rate_h
   }
   if (m.duration_s > kMaxDuration_s * (1.0 + 1e-12)) {
     Reject(motion.field_path + ".segments", m.duration_s,
-           "a total duration <= " + Num(kMaxDuration_s) + " s");
+           "a total duration <= " + CompactText(kMaxDuration_s) + " s");
   }
   m.num_steps = static_cast<int64_t>(std::floor(m.duration_s * rate_hz + 1e-9));
   if (m.num_steps < 1) {
     Reject(motion.field_path + ".segments", m.duration_s,
-           "a total duration of at least one output interval, 1 / rate_hz = " + Num(m.dt_s) + " s");
+           "a total duration of at least one output interval, 1 / rate_hz = " +
+               CompactText(m.dt_s) + " s");
   }
   for (size_t i = 1; i < m.pieces.size(); ++i) m.breakpoints.push_back(m.pieces[i].t0);
   while (!m.gps_invisible_s.empty() && m.gps_invisible_s.back().first >= m.duration_s) {

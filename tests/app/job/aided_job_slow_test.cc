@@ -39,7 +39,7 @@
 namespace driftlab::app {
 namespace {
 
-constexpr int kRuns = 500;
+constexpr int kAidedRuns = 500;
 
 // Standard normal quantile: bisection on erfc (to 1e-12; plenty for test bounds).
 double NormalQuantile(double p) {
@@ -75,7 +75,7 @@ JobFile CarDriveGnss(bool aided) {
   accel->set_scale_factor_sigma_ppm(0.0);
   accel->set_misalignment_sigma_mrad(0.0);
   accel->set_range_g(0.0);
-  job.mutable_monte_carlo()->set_runs(kRuns);
+  job.mutable_monte_carlo()->set_runs(kAidedRuns);
   job.mutable_monte_carlo()->set_covariance(true);
   if (!aided) {
     job.mutable_navigation()->set_filter(v1::Navigation::NONE);
@@ -98,7 +98,7 @@ Ran RunJob(const JobFile& file) {
   ran.result = ToJobResult(JobAsRun(file.job, spec), output, "test");
   std::printf("%s: %u runs, %.1f s wall (%.2f M samples/s on %u threads, covariance included)\n",
               file.job.navigation().filter() == v1::Navigation::INS_GNSS_EKF ? "EKF" : "free INS",
-              kRuns, ran.wall_s,
+              kAidedRuns, ran.wall_s,
               static_cast<double>(ran.result.timings().samples()) / ran.wall_s * 1e-6,
               ran.result.timings().threads());
   return ran;
@@ -122,9 +122,10 @@ void ExpectMonteCarloSigmaMatchesPrediction(const v1::JobResult& result,
   EXPECT_EQ(result.covariance().unrepresented_size(), 0);
   const int m = 9 * static_cast<int>(times_s.size());
   const double a = 0.05 / m;
-  const double lo = Chi2Quantile(kRuns - 1, a / 2), hi = Chi2Quantile(kRuns - 1, 1 - a / 2);
+  const double lo = Chi2Quantile(kAidedRuns - 1, a / 2),
+               hi = Chi2Quantile(kAidedRuns - 1, 1 - a / 2);
   std::printf("per-test interval of MC sigma / predicted: [%.3f, %.3f] (m = %d, a = %.2e)\n",
-              std::sqrt(lo / (kRuns - 1)), std::sqrt(hi / (kRuns - 1)), m, a);
+              std::sqrt(lo / (kAidedRuns - 1)), std::sqrt(hi / (kAidedRuns - 1)), m, a);
   double pooled = 0.0;
   for (int c = 0; c < 9; ++c) {
     std::printf("  %-24s", v1::ErrorComponent_Name(static_cast<v1::ErrorComponent>(c + 1)).c_str());
@@ -132,7 +133,7 @@ void ExpectMonteCarloSigmaMatchesPrediction(const v1::JobResult& result,
       const int e = EpochAt(result, t);
       const double s = result.epochs(e).components(c).std();
       const double p = result.covariance().epochs(e).sigma(c);
-      const double statistic = (kRuns - 1) * s * s / (p * p);
+      const double statistic = (kAidedRuns - 1) * s * s / (p * p);
       pooled += s * s / (p * p) / m;
       std::printf(" %6.0f s: %.3f", t, s / p);
       EXPECT_GE(statistic, lo) << "component " << c << " at " << t << " s: MC " << s
@@ -174,13 +175,14 @@ TEST_F(AidedJobSlowEkf, AverageNeesWithinChiSquareBounds) {
   const v1::JobResult& result = ran_->result;
   ASSERT_TRUE(result.has_filter_consistency());
   const std::vector<double> times_s = {100, 199, 259, 400, 600};
-  const double k = 9.0 * kRuns;
+  const double k = 9.0 * kAidedRuns;
   const double a = 0.05 / static_cast<double>(times_s.size());
-  const double lo = Chi2Quantile(k, a / 2) / kRuns, hi = Chi2Quantile(k, 1 - a / 2) / kRuns;
+  const double lo = Chi2Quantile(k, a / 2) / kAidedRuns,
+               hi = Chi2Quantile(k, 1 - a / 2) / kAidedRuns;
   double mean = 0.0;
   for (double t : times_s) {
     const v1::NeesEpoch& n = result.filter_consistency().epochs(EpochAt(result, t));
-    ASSERT_EQ(n.runs(), static_cast<uint64_t>(kRuns));
+    ASSERT_EQ(n.runs(), static_cast<uint64_t>(kAidedRuns));
     std::printf("average NEES at %.0f s: %.3f (Bonferroni 95 %% interval [%.3f, %.3f])\n", t,
                 n.average_nees(), lo, hi);
     EXPECT_GE(n.average_nees(), lo) << t;
@@ -188,7 +190,7 @@ TEST_F(AidedJobSlowEkf, AverageNeesWithinChiSquareBounds) {
     mean += n.average_nees() / static_cast<double>(times_s.size());
   }
   double lo1 = 0.0, hi1 = 0.0;
-  Chi2MeanBounds95(9, kRuns, &lo1, &hi1);
+  Chi2MeanBounds95(9, kAidedRuns, &lo1, &hi1);
   std::printf(
       "mean over the 5 epochs %.3f (conservative 95 %% interval [%.3f, %.3f]); mean over "
       "all epochs %.3f\n",
@@ -223,7 +225,7 @@ TEST_F(AidedJobSlowEkf, HorizontalErrorDuringSixtySecondOutageFollowsPrediction)
     const double ratio = rms * rms / (predicted * predicted);
     std::printf("  %.0f s: MC horizontal RMS %.3f m, predicted %.3f m, ratio of squares %.3f\n", t,
                 rms, predicted, ratio);
-    EXPECT_NEAR(ratio, 1.0, z * std::sqrt(2.0 / kRuns)) << t;
+    EXPECT_NEAR(ratio, 1.0, z * std::sqrt(2.0 / kAidedRuns)) << t;
   }
   // Reacquisition: the first epoch at or after 260 s with the MC horizontal RMS at or below its
   // value at 199 s. Averaging n independent 1 Hz fixes of 1.5 m per axis gives sqrt(2) 1.5 /

@@ -16,14 +16,15 @@
 #include "driftlab/monte_carlo.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/trajectory.h"
+#include "support/job_json.h"
 
 namespace driftlab::app {
 namespace {
 
 // A short drive: 20 s at rest, accelerate to 10 m/s, a 90 deg turn, 40 s straight, stop, 10 s at
 // rest (about 92 s), 50 Hz, tactical IMU without the terms the 15-state model cannot represent.
-std::string Job(const std::string& navigation, const std::string& aiding,
-                const std::string& monte_carlo = R"({"runs": 12, "seed": 3,
+std::string AidedJob(const std::string& navigation, const std::string& aiding,
+                     const std::string& monte_carlo = R"({"runs": 12, "seed": 3,
       "initial_errors": {"position_ned_m": [1, 1, 2], "velocity_ned_m_per_s": [0.05, 0.05, 0.05],
                          "attitude_deg": [0.05, 0.05, 0.2]}})") {
   return R"({"name": "aided", "rate_hz": 50,
@@ -53,7 +54,7 @@ const char kGnss[] =
     R"({"gnss": {"lever_arm_b_m": [0.5, 0, -1], "outages": [{"start_s": 40, "end_s": 60}]},
         "zupt": {"enabled": true}})";
 
-JobFile File(const std::string& json) { return JobFile{ParseJobJson(json), "."}; }
+using testing::File;
 
 // The SpecError message of translating (and, if that passes, running) the job; "" if none.
 std::string ErrorOf(const std::string& json, const MonteCarloOverrides& overrides = {}) {
@@ -93,7 +94,7 @@ TEST(AidedJob, ExampleTranslatesToTheEkfWithGnssOutageAndZupt) {
 
 TEST(AidedJob, DefaultsOfEachAid) {
   const MonteCarloSpec spec = ToMonteCarloSpec(
-      File(Job(kEkf, R"({"gnss": {}, "barometer": {}, "zupt": {"enabled": true}})")), {});
+      File(AidedJob(kEkf, R"({"gnss": {}, "barometer": {}, "zupt": {"enabled": true}})")), {});
   EXPECT_EQ(spec.aiding.gnss->rate_hz, 1.0);
   EXPECT_EQ(spec.aiding.gnss->position_sigma_ned_m, Eigen::Vector3d(1.5, 1.5, 3.0));
   EXPECT_TRUE(spec.aiding.gnss->use_velocity);
@@ -104,15 +105,16 @@ TEST(AidedJob, DefaultsOfEachAid) {
   EXPECT_EQ(spec.ekf_propagation_step_samples, 10);
   // An aid whose message is absent, or ZUPT not enabled, is not used.
   const MonteCarloSpec off = ToMonteCarloSpec(
-      File(Job(kEkf, R"({"gnss": {}, "zupt": {"velocity_sigma_m_per_s": 0.1}})")), {});
+      File(AidedJob(kEkf, R"({"gnss": {}, "zupt": {"velocity_sigma_m_per_s": 0.1}})")), {});
   EXPECT_FALSE(off.aiding.zupt.has_value());
   EXPECT_FALSE(off.aiding.barometer.has_value());
 
   const MonteCarloSpec comp = ToMonteCarloSpec(
-      File(Job(R"({"filter": "COMPLEMENTARY", "complementary": {"pair": "BUTTERWORTH4",
+      File(
+          AidedJob(R"({"filter": "COMPLEMENTARY", "complementary": {"pair": "BUTTERWORTH4",
                    "crossover_hz": 0.05}})",
-               R"({"magnetometer": {"hard_iron_ut": [1, 2, 3], "soft_iron": [1.01, 0.99, 1]}})",
-               R"({"runs": 2})")),
+                   R"({"magnetometer": {"hard_iron_ut": [1, 2, 3], "soft_iron": [1.01, 0.99, 1]}})",
+                   R"({"runs": 2})")),
       {});
   EXPECT_EQ(comp.filter, NavigationFilterKind::kComplementary);
   EXPECT_EQ(comp.complementary.kind, ComplementaryPairKind::kButterworth4);
@@ -203,13 +205,13 @@ TEST(AidedJob, BadAidingConfigurationNamesTheField) {
   for (const BadCase& c : cases) {
     MonteCarloOverrides overrides;
     overrides.covariance = c.covariance_flag;
-    const std::string message = ErrorOf(Job(c.navigation, c.aiding, c.monte_carlo), overrides);
+    const std::string message = ErrorOf(AidedJob(c.navigation, c.aiding, c.monte_carlo), overrides);
     EXPECT_EQ(message.rfind(c.field + ": ", 0), 0u) << c.aiding << " -> " << message;
     EXPECT_NE(message.find(c.contains), std::string::npos) << c.aiding << " -> " << message;
   }
   // An unknown filter is rejected by the schema check, naming the field and the allowed names.
   try {
-    ParseJobJson(Job(R"({"filter": "KALMAN"})", "{}"));
+    ParseJobJson(AidedJob(R"({"filter": "KALMAN"})", "{}"));
     ADD_FAILURE() << "unknown filter accepted";
   } catch (const SpecError& e) {
     const std::string message = e.what();
@@ -222,8 +224,8 @@ TEST(AidedJob, BadAidingConfigurationNamesTheField) {
 // component order and units; a job split into shards and merged through result files equals the
 // single-process result bit for bit, NEES sums included.
 TEST(AidedJob, ResultCarriesPredictedSigmaAndNeesAndShardsMergeBitForBit) {
-  const std::string json = Job(kEkf, kGnss,
-                               R"({"runs": 12, "seed": 3, "covariance": true,
+  const std::string json = AidedJob(kEkf, kGnss,
+                                    R"({"runs": 12, "seed": 3, "covariance": true,
       "initial_errors": {"position_ned_m": [1, 1, 2], "velocity_ned_m_per_s": [0.05, 0.05, 0.05],
                          "attitude_deg": [0.05, 0.05, 0.2]}})");
   const JobFile file = File(json);
@@ -294,8 +296,8 @@ TEST(AidedJob, ResultCarriesPredictedSigmaAndNeesAndShardsMergeBitForBit) {
 // The complementary filter through the job path: attitude errors only (position and velocity are
 // not estimated and reported as 0), no covariance, no NEES.
 TEST(AidedJob, ComplementaryFilterReportsAttitudeErrorsOnly) {
-  const JobFile file = File(Job(R"({"filter": "COMPLEMENTARY"})", R"({"magnetometer": {}})",
-                                R"({"runs": 4, "seed": 5})"));
+  const JobFile file = File(AidedJob(R"({"filter": "COMPLEMENTARY"})", R"({"magnetometer": {}})",
+                                     R"({"runs": 4, "seed": 5})"));
   const MonteCarloSpec spec = ToMonteCarloSpec(file, {});
   const v1::JobResult result =
       ToJobResult(JobAsRun(file.job, spec), RunMonteCarloWithAnalysis(spec), "test");

@@ -31,13 +31,13 @@
 namespace driftlab::app {
 namespace {
 
-constexpr uint32_t kRuns = 60;
+constexpr uint32_t kConsistencyRuns = 60;
 
-JobFile CarDriveGnss(const std::string& preset) {
+JobFile CarDriveGnssWithPreset(const std::string& preset) {
   JobFile file = LoadJobFile(std::string(DRIFTLAB_SOURCE_DIR) + "/examples/car_drive_gnss.json");
   file.job.mutable_sensor()->Clear();
   file.job.mutable_sensor()->set_preset(preset);
-  file.job.mutable_monte_carlo()->set_runs(kRuns);
+  file.job.mutable_monte_carlo()->set_runs(kConsistencyRuns);
   file.job.mutable_monte_carlo()->set_covariance(true);
   return file;
 }
@@ -61,9 +61,10 @@ void ExpectConsistent(const JobFile& file) {
   const double alpha = testing::kFamilyAlpha / testing::kChecksPerComponent;
   for (size_t pick : testing::EvenlySpacedPicks(candidates.size(), testing::kChecksPerComponent)) {
     const size_t e = candidates[pick];
-    ASSERT_EQ(c.nees_count[e], kRuns);
-    const double nees = static_cast<double>(c.nees_sum[e].Value()) / kRuns;
-    const NeesBand band = AverageNeesBand(FilterConsistencyData::kStateDimension, kRuns, alpha);
+    ASSERT_EQ(c.nees_count[e], kConsistencyRuns);
+    const double nees = static_cast<double>(c.nees_sum[e].Value()) / kConsistencyRuns;
+    const NeesBand band =
+        AverageNeesBand(FilterConsistencyData::kStateDimension, kConsistencyRuns, alpha);
     std::printf("average NEES at %.0f s: %.3f, band [%.3f, %.3f]\n", t[e], nees, band.low,
                 band.high);
     EXPECT_GE(nees, band.low) << t[e];
@@ -72,10 +73,12 @@ void ExpectConsistent(const JobFile& file) {
 }
 
 TEST(FilterModel, CarDriveGnssExampleTacticalIsConsistent) {
-  ExpectConsistent(CarDriveGnss("tactical"));
+  ExpectConsistent(CarDriveGnssWithPreset("tactical"));
 }
 
-TEST(FilterModel, Stim300OnCarDriveGnssIsConsistent) { ExpectConsistent(CarDriveGnss("stim300")); }
+TEST(FilterModel, Stim300OnCarDriveGnssIsConsistent) {
+  ExpectConsistent(CarDriveGnssWithPreset("stim300"));
+}
 
 // The mistuned-filter study. The truth IMU is seed002-gladiator-landmark (white noise only, ARW
 // 1 deg/sqrt(h): the gyro error on this drive is all ARW, so halving it in the filter must show);
@@ -93,7 +96,7 @@ ConsistencyVerdict VerdictOf(const JobFile& file) {
 }
 
 TEST(FilterModel, FilterAssumingHalfTheGyroArwShowsNeesAboveItsBand) {
-  const JobFile truth_tuned = CarDriveGnss("seed002-gladiator-landmark");
+  const JobFile truth_tuned = CarDriveGnssWithPreset("seed002-gladiator-landmark");
   const ConsistencyVerdict control = VerdictOf(truth_tuned);
   std::printf("truth-tuned: %s\n", control.Summary().c_str());
   EXPECT_TRUE(control.consistent());
@@ -113,7 +116,7 @@ TEST(FilterModel, FilterAssumingHalfTheGyroArwShowsNeesAboveItsBand) {
 
 TEST(FilterModel, BadFilterModelFieldsNameFieldValueAndRange) {
   auto error_of = [](const std::string& field_json) {
-    JobFile file = CarDriveGnss("tactical");
+    JobFile file = CarDriveGnssWithPreset("tactical");
     const std::string json =
         R"({"filter": "INS_GNSS_EKF", "ned": {"vertical_channel": "FREE"}, "ekf": )" + field_json +
         "}";

@@ -19,8 +19,6 @@ namespace driftlab::app {
 namespace {
 
 const std::filesystem::path kExamples = std::filesystem::path(DRIFTLAB_SOURCE_DIR) / "examples";
-const std::filesystem::path kData = DRIFTLAB_CLI_TEST_DATA;
-constexpr double kDeg = M_PI / 180.0;
 
 // A valid job moving north at 10 m/s with the given segments and extra top-level fields.
 std::string JobWithSegments(const std::string& segments, const std::string& extra = "") {
@@ -33,7 +31,7 @@ std::string JobWithSegments(const std::string& segments, const std::string& extr
 // The SpecError message of parsing and translating `json`, or "" if it is valid.
 std::string JsonError(const std::string& json) {
   try {
-    ToSimulationSpec(ParseJobJson(json), kData);
+    ToSimulationSpec(ParseJobJson(json), kTestData);
   } catch (const SpecError& e) {
     return e.what();
   }
@@ -42,7 +40,7 @@ std::string JsonError(const std::string& json) {
 
 std::string YamlError(const std::string& yaml) {
   try {
-    ToSimulationSpec(ParseJobYaml(yaml), kData);
+    ToSimulationSpec(ParseJobYaml(yaml), kTestData);
   } catch (const SpecError& e) {
     return e.what();
   }
@@ -51,7 +49,7 @@ std::string YamlError(const std::string& yaml) {
 
 TEST(JobSpec, YamlJobEqualsItsJsonTwin) {
   const JobFile yaml = LoadJobFile(kExamples / "aircraft_climb_turns.yaml");
-  const JobFile json = LoadJobFile(kData / "aircraft_climb_turns_twin.json");
+  const JobFile json = LoadJobFile(kTestData / "aircraft_climb_turns_twin.json");
   EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(yaml.job, json.job))
       << yaml.job.DebugString() << "\nvs\n"
       << json.job.DebugString();
@@ -89,7 +87,7 @@ TEST(JobSpec, AnglesAreConvertedFromDegreesToRadians) {
                                   "segments": [{"turn": {"rate_deg_per_s": 36,
                                                          "angle_deg": 720}}]},
                       "rate_hz": 100})"),
-      kData);
+      kTestData);
   // One multiplication by pi/180: within 4 ulp (EXPECT_DOUBLE_EQ) of the exact radian value.
   EXPECT_DOUBLE_EQ(spec.motion.initial.llh.lat_rad, M_PI / 4);
   EXPECT_DOUBLE_EQ(spec.motion.initial.llh.lon_rad, -3.7722 * kDeg);
@@ -109,7 +107,7 @@ TEST(JobSpec, AbsentOptionalFieldsTakeTheDocumentedDefaults) {
       ParseJobJson(JobWithSegments(R"({"climb": {"climb_rate_m_per_s": 2, "duration_s": 30}},
                                       {"turn": {"radius_m": 100, "duration_s": 10}},
                                       {"figure_eight": {"radius_m": 50}})")),
-      kData);
+      kTestData);
   EXPECT_EQ(spec.motion.earth_model, EarthModel::kWgs84);
   EXPECT_FALSE(spec.motion.flat_gravity_m_per_s2.has_value());
   EXPECT_EQ(spec.mechanization, MechanizationKind::kNed);
@@ -136,7 +134,7 @@ TEST(JobSpec, EnumsAndOptionsReachTheEngineSpec) {
                                              "coning_sculling": false},
                                      "seed000": {"static_period_s": 60,
                                                  "lowpass_cutoff_hz": 5}}})"),
-      kData);
+      kTestData);
   EXPECT_EQ(spec.motion.earth_model, EarthModel::kFlat);
   EXPECT_EQ(spec.motion.flat_gravity_m_per_s2, 9.8);
   EXPECT_TRUE(spec.motion.vehicle.coordinated_turns);
@@ -400,7 +398,7 @@ TEST(JobSpec, TruthProfileFileIsTheWholeMotion) {
 
 TEST(JobSpec, EngineChecksThatNeedThePlannedMotionRunInValidateJob) {
   // A static segment entered at 10 m/s passes the field checks; the generator rejects it.
-  JobFile file{ParseJobJson(JobWithSegments(R"({"static": {"duration_s": 10}})")), kData};
+  JobFile file{ParseJobJson(JobWithSegments(R"({"static": {"duration_s": 10}})")), kTestData};
   EXPECT_NO_THROW(ToSimulationSpec(file.job, file.base_dir));
   try {
     ValidateJob(file);

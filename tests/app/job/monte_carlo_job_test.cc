@@ -12,12 +12,13 @@
 #include "driftlab/app/result_file.h"
 #include "driftlab/monte_carlo.h"
 #include "driftlab/spec_error.h"
+#include "support/job_json.h"
 
 namespace driftlab::app {
 namespace {
 
 // A short job: 60 s at rest then 60 s driving, 50 Hz, tactical IMU, small initial errors.
-std::string Job(const std::string& monte_carlo, const std::string& extra = "") {
+std::string JobWithMonteCarlo(const std::string& monte_carlo, const std::string& extra = "") {
   return R"({"name": "short", "rate_hz": 50,
     "motion": {"initial": {"lat_deg": 30, "lon_deg": 10, "yaw_deg": 20},
                "segments": [{"static": {"duration_s": 60}},
@@ -30,7 +31,7 @@ std::string Job(const std::string& monte_carlo, const std::string& extra = "") {
          monte_carlo + extra + "}";
 }
 
-JobFile File(const std::string& json) { return JobFile{ParseJobJson(json), "."}; }
+using testing::File;
 
 std::string SpecErrorOf(const std::string& json, const MonteCarloOverrides& overrides = {}) {
   try {
@@ -42,7 +43,7 @@ std::string SpecErrorOf(const std::string& json, const MonteCarloOverrides& over
 }
 
 TEST(MonteCarloJob, DefaultsAndOverrides) {
-  const MonteCarloSpec spec = ToMonteCarloSpec(File(Job("{}")), {});
+  const MonteCarloSpec spec = ToMonteCarloSpec(File(JobWithMonteCarlo("{}")), {});
   EXPECT_EQ(spec.runs, kDefaultRuns);
   EXPECT_EQ(spec.seed, 1u);
   EXPECT_EQ(spec.first_run, 0u);
@@ -55,7 +56,8 @@ TEST(MonteCarloJob, DefaultsAndOverrides) {
   overrides.runs = 10;
   overrides.seed = 99;
   ParseShard("2/3", &overrides);
-  const MonteCarloSpec shard = ToMonteCarloSpec(File(Job(R"({"runs": 500})")), overrides);
+  const MonteCarloSpec shard =
+      ToMonteCarloSpec(File(JobWithMonteCarlo(R"({"runs": 500})")), overrides);
   EXPECT_EQ(shard.runs, 10u);
   EXPECT_EQ(shard.seed, 99u);
   // Shard i of K holds runs [floor(i N / K), floor((i + 1) N / K)): 2/3 of 10 = [6, 10).
@@ -64,11 +66,13 @@ TEST(MonteCarloJob, DefaultsAndOverrides) {
 }
 
 TEST(MonteCarloJob, BadSettingsNameTheField) {
-  EXPECT_NE(SpecErrorOf(Job(R"({"runs": 0})")).find("monte_carlo.runs: 0 is not allowed"),
-            std::string::npos);
+  EXPECT_NE(
+      SpecErrorOf(JobWithMonteCarlo(R"({"runs": 0})")).find("monte_carlo.runs: 0 is not allowed"),
+      std::string::npos);
   MonteCarloOverrides runs;
   runs.runs = 0;
-  EXPECT_NE(SpecErrorOf(Job("{}"), runs).find("--runs: 0 is not allowed"), std::string::npos);
+  EXPECT_NE(SpecErrorOf(JobWithMonteCarlo("{}"), runs).find("--runs: 0 is not allowed"),
+            std::string::npos);
   for (const char* bad : {"4/4", "1/0", "a/b", "1", "-1/3", "1/3/4"}) {
     MonteCarloOverrides overrides;
     try {
@@ -83,24 +87,24 @@ TEST(MonteCarloJob, BadSettingsNameTheField) {
   MonteCarloOverrides many;
   many.runs = 3;
   ParseShard("0/4", &many);
-  EXPECT_NE(SpecErrorOf(Job("{}"), many)
+  EXPECT_NE(SpecErrorOf(JobWithMonteCarlo("{}"), many)
                 .find("--shard: 0/4 is not allowed; allowed: i/K with K "
                       "<= runs = 3"),
             std::string::npos);
-  EXPECT_NE(SpecErrorOf(Job(R"({"epoch_interval_s": 0.03})"))
+  EXPECT_NE(SpecErrorOf(JobWithMonteCarlo(R"({"epoch_interval_s": 0.03})"))
                 .find("monte_carlo.epoch_interval_s: 0.03 is not allowed; allowed: a multiple of "
                       "the IMU interval"),
             std::string::npos);
-  EXPECT_NE(SpecErrorOf(Job(R"({"epoch_interval_s": 1, "epoch_times_s": [5]})"))
+  EXPECT_NE(SpecErrorOf(JobWithMonteCarlo(R"({"epoch_interval_s": 1, "epoch_times_s": [5]})"))
                 .find("monte_carlo: both epoch_interval_s and epoch_times_s"),
             std::string::npos);
-  EXPECT_NE(SpecErrorOf(Job(R"({"initial_errors": {"attitude_deg": [1, -1, 0]}})"))
+  EXPECT_NE(SpecErrorOf(JobWithMonteCarlo(R"({"initial_errors": {"attitude_deg": [1, -1, 0]}})"))
                 .find("monte_carlo.initial_errors.attitude_deg[1]: -1 is not allowed"),
             std::string::npos);
-  EXPECT_NE(SpecErrorOf(Job(R"({"initialization": {"kind": "STATIC_ALIGNMENT"}})"))
+  EXPECT_NE(SpecErrorOf(JobWithMonteCarlo(R"({"initialization": {"kind": "STATIC_ALIGNMENT"}})"))
                 .find("monte_carlo.initialization.alignment_duration_s: missing"),
             std::string::npos);
-  EXPECT_NE(SpecErrorOf(Job(R"({"initialization": {"kind": "STATIC_ALIGNMENT",
+  EXPECT_NE(SpecErrorOf(JobWithMonteCarlo(R"({"initialization": {"kind": "STATIC_ALIGNMENT",
                                   "alignment_duration_s": 30},
                                 "initial_errors": {"attitude_deg": [1, 1, 1]}})"))
                 .find("monte_carlo.initial_errors.attitude_deg: non-zero is not allowed"),
@@ -125,7 +129,7 @@ void ExpectSameStatistics(v1::JobResult a, v1::JobResult b) {
 }
 
 TEST(MonteCarloJob, FourShardsMergedThroughFilesEqualOneProcessBitForBit) {
-  const std::string json = Job(R"({"runs": 22, "seed": 5, "epoch_interval_s": 2,
+  const std::string json = JobWithMonteCarlo(R"({"runs": 22, "seed": 5, "epoch_interval_s": 2,
                                    "checkpoint_times_s": [30],
                                    "initial_errors": {"attitude_deg": [0.01, 0.01, 0.1]}})");
   MonteCarloOverrides whole;
@@ -156,7 +160,9 @@ TEST(MonteCarloJob, FourShardsMergedThroughFilesEqualOneProcessBitForBit) {
   EXPECT_THROW(MergeJobResults({shards[0], shards[0]}, {"a", "b"}, "test"), SpecError);
   // A shard of another job (different seed) is refused.
   const v1::JobResult other = RunToResult(
-      Job(R"({"runs": 22, "seed": 6, "epoch_interval_s": 2, "checkpoint_times_s": [30]})"), [] {
+      JobWithMonteCarlo(
+          R"({"runs": 22, "seed": 6, "epoch_interval_s": 2, "checkpoint_times_s": [30]})"),
+      [] {
         MonteCarloOverrides o;
         ParseShard("0/4", &o);
         return o;
@@ -165,8 +171,8 @@ TEST(MonteCarloJob, FourShardsMergedThroughFilesEqualOneProcessBitForBit) {
 }
 
 TEST(MonteCarloJob, ResultAnglesAreInDegreesAndSummariesAreConsistent) {
-  const v1::JobResult result =
-      RunToResult(Job(R"({"runs": 12, "initial_errors": {"attitude_deg": [0.5, 0.5, 2]}})"), {});
+  const v1::JobResult result = RunToResult(
+      JobWithMonteCarlo(R"({"runs": 12, "initial_errors": {"attitude_deg": [0.5, 0.5, 2]}})"), {});
   // At t = 0 the attitude errors are the initial errors: the sample std of 12 draws of N(0, s^2)
   // lies within [0.45 s, 1.55 s] with probability > 0.99 (chi-square, 11 dof: 0.2 % and 99.8 %
   // quantiles 2.6 and 30 -> sqrt(2.6/11) = 0.49, sqrt(30/11) = 1.65; the tolerance is looser).

@@ -14,7 +14,6 @@
 namespace driftlab::app {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr double kG = 9.80665;  // standard gravity, exact (CGPM 1901)
 
 v1::Job JobWithSensor(const std::string& sensor) {

@@ -12,13 +12,14 @@
 #include "driftlab/monte_carlo.h"
 #include "driftlab/nav_state.h"
 #include "driftlab/spec_error.h"
+#include "support/job_json.h"
 
 namespace driftlab::app {
 namespace {
 
 // 120 s at rest, 100 Hz; `monte_carlo` and `extra` fields spliced in.
-std::string Job(const std::string& monte_carlo, double rate_hz = 100.0, double duration_s = 120.0,
-                const std::string& name = "short") {
+std::string JobWithMonteCarloAt(const std::string& monte_carlo, double rate_hz = 100.0,
+                                double duration_s = 120.0, const std::string& name = "short") {
   return R"({"name": ")" + name + R"(", "rate_hz": )" + std::to_string(rate_hz) +
          R"(, "motion": {"initial": {"lat_deg": 45, "lon_deg": 7},
                "segments": [{"static": {"duration_s": )" +
@@ -29,7 +30,7 @@ std::string Job(const std::string& monte_carlo, double rate_hz = 100.0, double d
          monte_carlo + "}";
 }
 
-JobFile File(const std::string& json) { return JobFile{ParseJobJson(json), "."}; }
+using testing::File;
 
 // The field a SpecError names, "" when the job is accepted.
 std::string RefusedField(const std::string& json, const MonteCarloOverrides& overrides = {}) {
@@ -42,30 +43,35 @@ std::string RefusedField(const std::string& json, const MonteCarloOverrides& ove
 }
 
 TEST(ValidationPath, CheckpointsAgainstTheTrajectoryAreCheckedWithoutRunning) {
-  EXPECT_EQ(RefusedField(Job(R"({"runs": 2, "checkpoint_times_s": [10, 60]})")), "");
+  EXPECT_EQ(RefusedField(JobWithMonteCarloAt(R"({"runs": 2, "checkpoint_times_s": [10, 60]})")),
+            "");
   // Past the trajectory's end (120 s): validate refuses it as RunMonteCarlo does.
-  EXPECT_EQ(RefusedField(Job(R"({"runs": 2, "checkpoint_times_s": [10, 500]})")),
+  EXPECT_EQ(RefusedField(JobWithMonteCarloAt(R"({"runs": 2, "checkpoint_times_s": [10, 500]})")),
             "monte_carlo.checkpoint_times_s[1]");
   // Not ascending.
-  EXPECT_EQ(RefusedField(Job(R"({"runs": 2, "checkpoint_times_s": [60, 10]})")),
+  EXPECT_EQ(RefusedField(JobWithMonteCarloAt(R"({"runs": 2, "checkpoint_times_s": [60, 10]})")),
             "monte_carlo.checkpoint_times_s[1]");
   // Two times on one sample of the 100 Hz grid (dt = 10 ms).
-  EXPECT_EQ(RefusedField(Job(R"({"runs": 2, "checkpoint_times_s": [10, 10.001]})")),
+  EXPECT_EQ(RefusedField(JobWithMonteCarloAt(R"({"runs": 2, "checkpoint_times_s": [10, 10.001]})")),
             "monte_carlo.checkpoint_times_s[1]");
 }
 
 TEST(ValidationPath, EpochLimitIsCheckedWithoutRunning) {
   // One epoch per sample of 10 000 s at 100 Hz: 1 000 001 epochs, over the engine's limit.
   ASSERT_LT(kMaxMonteCarloEpochs, size_t{1'000'001});
-  EXPECT_EQ(RefusedField(Job(R"({"runs": 1, "epoch_interval_s": 0.01})", 100.0, 10000.0)),
-            "monte_carlo.epoch_every_samples");
-  EXPECT_EQ(RefusedField(Job(R"({"runs": 1, "epoch_interval_s": 1})", 100.0, 10000.0)), "");
+  EXPECT_EQ(
+      RefusedField(JobWithMonteCarloAt(R"({"runs": 1, "epoch_interval_s": 0.01})", 100.0, 10000.0)),
+      "monte_carlo.epoch_every_samples");
+  EXPECT_EQ(
+      RefusedField(JobWithMonteCarloAt(R"({"runs": 1, "epoch_interval_s": 1})", 100.0, 10000.0)),
+      "");
 }
 
 TEST(ValidationPath, JobOverItsMemoryLimitIsRefusedBeforeAnyAllocation) {
   // 1 run x 100 000 s at 2000 Hz = 2e8 IMU increments of shared truth, each two
   // 3-vectors of doubles (48 bytes): at least 9.6 GB, over the 8 GB default.
-  const std::string job = Job(R"({"runs": 1, "epoch_interval_s": 10})", 2000.0, 100000.0);
+  const std::string job =
+      JobWithMonteCarloAt(R"({"runs": 1, "epoch_interval_s": 10})", 2000.0, 100000.0);
   const uint64_t lower_bound = uint64_t{200'000'000} * sizeof(ImuIncrement);
   MonteCarloOverrides unlimited;
   unlimited.max_memory_bytes = 0;
@@ -91,17 +97,19 @@ TEST(ValidationPath, JobOverItsMemoryLimitIsRefusedBeforeAnyAllocation) {
 }
 
 TEST(ValidationPath, FieldSizesAreBounded) {
-  EXPECT_EQ(RefusedField(Job(R"({"runs": 2})", 100.0, 120.0, std::string(kMaxJobNameBytes, 'n'))),
+  EXPECT_EQ(RefusedField(JobWithMonteCarloAt(R"({"runs": 2})", 100.0, 120.0,
+                                             std::string(kMaxJobNameBytes, 'n'))),
             "");
-  EXPECT_EQ(
-      RefusedField(Job(R"({"runs": 2})", 100.0, 120.0, std::string(kMaxJobNameBytes + 1, 'n'))),
-      "name");
+  EXPECT_EQ(RefusedField(JobWithMonteCarloAt(R"({"runs": 2})", 100.0, 120.0,
+                                             std::string(kMaxJobNameBytes + 1, 'n'))),
+            "name");
   // A repeated field over its entry limit is refused by its size, before its values are checked.
   std::string times = "[";
   for (int i = 0; i <= kMaxJobRepeatedFieldSize; ++i) times += (i ? ",1" : "1");
   times += "]";
-  EXPECT_EQ(RefusedField(Job(R"({"runs": 2, "checkpoint_times_s": )" + times + "}")),
-            "monte_carlo.checkpoint_times_s");
+  EXPECT_EQ(
+      RefusedField(JobWithMonteCarloAt(R"({"runs": 2, "checkpoint_times_s": )" + times + "}")),
+      "monte_carlo.checkpoint_times_s");
 }
 
 }  // namespace

@@ -36,7 +36,7 @@ namespace {
 // 4 s keep the results small.
 constexpr double kArwDegPerSqrtH = 0.5;
 
-v1::JobResult RunJob(double arw_scale, uint64_t seed, uint32_t runs) {
+v1::JobResult RunArwJob(double arw_scale, uint64_t seed, uint32_t runs) {
   JobFile file = LoadJobFile(std::string(DRIFTLAB_CLI_TEST_DATA) + "/gate_arw_drive.json");
   file.job.mutable_sensor()->mutable_gyro()->set_arw_deg_per_sqrt_h(kArwDegPerSqrtH * arw_scale);
   MonteCarloOverrides overrides;
@@ -61,8 +61,8 @@ TEST(GateSlow, IndependentSeedsOfTheSameJobFailAtMostTenOfOneHundredGates) {
   int failed = 0, inconclusive_gates = 0, inconclusive_metrics = 0, metrics = 0;
   for (int pair = 0; pair < 100; ++pair) {
     const uint64_t seed_b = 1001 + 2 * pair, seed_c = 1002 + 2 * pair;
-    const v1::JobResult baseline = RunJob(1.0, seed_b, 200);
-    const v1::JobResult current = RunJob(1.0, seed_c, 200);
+    const v1::JobResult baseline = RunArwJob(1.0, seed_b, 200);
+    const v1::JobResult current = RunArwJob(1.0, seed_c, 200);
     const GateReport report = RunGate(baseline, current, DefaultGateRules(), Options(false));
     ASSERT_FALSE(report.paired);
     failed += report.passed() ? 0 : 1;
@@ -81,15 +81,15 @@ TEST(GateSlow, IndependentSeedsOfTheSameJobFailAtMostTenOfOneHundredGates) {
 TEST(GateSlow, GyroArwTimesOnePointThreeIsCaughtAtThePlannedRunCount) {
   const auto start = std::chrono::steady_clock::now();
   // The number of metrics the default rules gate, from one small result of the job.
-  const v1::JobResult probe = RunJob(1.0, 1, 10);
+  const v1::JobResult probe = RunArwJob(1.0, 1, 10);
   const int gated =
       static_cast<int>(RunGate(probe, probe, DefaultGateRules(), Options(false)).rows.size());
   const long runs = RunsForSigmaChange(1.3, kDefaultRelTol, kDefaultAlpha, gated);
   ASSERT_GT(runs, 0);
   int caught = 0;
   for (int pair = 0; pair < 50; ++pair) {
-    const v1::JobResult baseline = RunJob(1.0, 3001 + 2 * pair, static_cast<uint32_t>(runs));
-    const v1::JobResult degraded = RunJob(1.3, 3002 + 2 * pair, static_cast<uint32_t>(runs));
+    const v1::JobResult baseline = RunArwJob(1.0, 3001 + 2 * pair, static_cast<uint32_t>(runs));
+    const v1::JobResult degraded = RunArwJob(1.3, 3002 + 2 * pair, static_cast<uint32_t>(runs));
     // ARW x 1.3 is a different sensor model: compared on purpose.
     const GateReport report = RunGate(baseline, degraded, DefaultGateRules(), Options(true));
     caught += report.passed() ? 0 : 1;
@@ -109,11 +109,11 @@ TEST(GateSlow, PairedGateCatchesArwTimesOnePointZeroFiveAtTwoPercent) {
       "rules:\n  - {metric: 'final.*', rel_tol: 0.02}\n"
       "  - {metric: 'final.*.abs_mean', skip: true}\n"
       "  - {metric: 'final.*.p99', skip: true}\n");
-  const v1::JobResult baseline = RunJob(1.0, 1, 200);
-  const GateReport same = RunGate(baseline, RunJob(1.0, 1, 200), rules, Options(false));
+  const v1::JobResult baseline = RunArwJob(1.0, 1, 200);
+  const GateReport same = RunGate(baseline, RunArwJob(1.0, 1, 200), rules, Options(false));
   EXPECT_TRUE(same.paired);
   EXPECT_TRUE(same.passed()) << FormatGateTable(same);
-  const GateReport degraded = RunGate(baseline, RunJob(1.05, 1, 200), rules, Options(true));
+  const GateReport degraded = RunGate(baseline, RunArwJob(1.05, 1, 200), rules, Options(true));
   EXPECT_TRUE(degraded.paired);
   EXPECT_FALSE(degraded.passed());
   int horizontal = 0;

@@ -14,20 +14,12 @@
 #include "driftlab/complementary_filter.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/trajectory.h"
+#include "support/spec_errors.h"
 
 namespace driftlab {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const SpecError& e) {
-    return e.what();
-  }
-  return "";
-}
+using testing::ErrorOf;
 
 // Over N independent runs, the barometer error (measured - truth) at one epoch has variance
 // noise^2 + bias^2, and between epochs T apart covariance bias^2 exp(-T / tau) (first-order

@@ -12,8 +12,6 @@
 namespace driftlab {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-
 TEST(EarthTest, NormalGravityAtEquatorAndPoleMatchesNimaTr8350) {
   // NIMA TR8350.2 (2000) table 3.4: gamma_e = 9.7803253359, gamma_p = 9.8321849378 m/s^2.
   // Tolerance: half a unit of the last printed digit (5e-11) plus rounding of the closed formula.

@@ -14,8 +14,6 @@
 namespace driftlab {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-
 TEST(ComplementaryPair, FirstOrderPairSumsToOneAndEachIsMinus3dBAtCrossover) {
   const ComplementaryPairDesign d =
       DesignComplementaryPair(ComplementaryPairKind::kFirstOrder, 0.5, 100.0);

@@ -21,8 +21,6 @@
 namespace driftlab {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-
 // Car drive of 300 s: static, accelerate to 20 m/s, turns both ways, straights, slow down.
 MotionSpec CarDrive() {
   MotionSpec m;

@@ -18,12 +18,11 @@
 #include "driftlab/spec_error.h"
 #include "driftlab/trajectory.h"
 #include "support/bonferroni_checks.h"
+#include "support/imu_models.h"
 #include "support/motion_builders.h"
 
 namespace driftlab {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 // Car-like drive: 10 s static, accelerate to 20 m/s, straight, two turns, straight, slow down.
 MotionSpec CarMotion() {
@@ -140,17 +139,7 @@ TEST(ErrorStateModel, VanLoanAndSecondOrderDiscretisationsAgreeToThirdOrder) {
   }
 }
 
-// Representable part of the tactical preset: white noise and turn-on bias (random constants).
-ImuErrorModel TacticalRepresentable() {
-  ImuErrorModel model = FindImuPreset("tactical");
-  for (TriadErrorParams* p : {&model.gyro, &model.accel}) {
-    p->bias_flicker = {};
-    p->scale_factor_sigma = 0.0;
-    p->misalignment_sigma_rad = 0.0;
-    p->range = 0.0;
-  }
-  return model;
-}
+using testing::TacticalRepresentable;
 
 TEST(ErrorStateModel, NoiseFromImuRepresentsEveryStochasticTermAndNamesTheRest) {
   const ErrorStateNoiseFromImu full = MakeErrorStateNoise(FindImuPreset("tactical"));

@@ -19,7 +19,6 @@
 namespace driftlab {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 using testing::DriveWithFinalStraight;
 
 // Seed 1, the first tried. Acceptance: every check at its Bonferroni-corrected level, family-wise

@@ -15,8 +15,6 @@
 namespace driftlab {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-
 // Final-epoch closure bounds for the hour-long runs (brief). Why they are reachable:
 //  - a tilt error psi makes a Schuler position error up to R psi (6.4e6 m x psi): 0.05 m needs the
 //    accumulated tilt below ~8e-9 rad;

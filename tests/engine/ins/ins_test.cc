@@ -18,8 +18,6 @@
 namespace driftlab {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-
 // Exact increments of a body at rest on the rotating Earth: omega_ib_b = C_n_b omega_ie_n and
 // f_ib_b = -C_n_b g_b_n are constant in the body frame, so the interval integrals are the rates
 // times dt (Groves (5.40), (5.54) with v = 0).

@@ -11,21 +11,12 @@
 #include <string>
 
 #include "driftlab/spec_error.h"
+#include "support/spec_errors.h"
 
 namespace driftlab {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-const std::filesystem::path kData = std::filesystem::path(DRIFTLAB_SOURCE_DIR) / "tests" / "data";
-
-std::string ErrorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const SpecError& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
+using testing::ErrorOf;
 
 std::filesystem::path TempDir(const std::string& name) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() /
@@ -43,7 +34,7 @@ std::vector<std::string> Lines(const std::filesystem::path& path) {
 }
 
 TEST(GnssInsSimMotion, ReadsTheNinetyDegreeTurnFile) {
-  const std::filesystem::path file = kData / "gnss_ins_sim_90deg_turn.csv";
+  const std::filesystem::path file = kTestData / "gnss_ins_sim_90deg_turn.csv";
   const MotionSpec m = ReadGnssInsSimMotion(file);
   EXPECT_EQ(m.earth_model, EarthModel::kWgs84);
   EXPECT_DOUBLE_EQ(m.initial.llh.lat_rad, 31.9965 * kDeg);
@@ -64,7 +55,7 @@ TEST(GnssInsSimMotion, ReadsTheNinetyDegreeTurnFile) {
 }
 
 TEST(GnssInsSimMotion, ReadsAllCommandTypesAndAnOptionalGpsColumn) {
-  const MotionSpec m = ReadGnssInsSimMotion(kData / "gnss_ins_sim_all_types.csv");
+  const MotionSpec m = ReadGnssInsSimMotion(kTestData / "gnss_ins_sim_all_types.csv");
   ASSERT_EQ(m.segments.size(), 6u);
   const int types[6] = {1, 2, 3, 4, 5, 1};
   for (size_t i = 0; i < 6; ++i)
@@ -76,11 +67,11 @@ TEST(GnssInsSimMotion, ReadsAllCommandTypesAndAnOptionalGpsColumn) {
 }
 
 TEST(GnssInsSimMotion, BadFilesNameFileLineAndColumn) {
-  const std::filesystem::path type_file = kData / "bad_command_type.csv";
+  const std::filesystem::path type_file = kTestData / "bad_command_type.csv";
   EXPECT_EQ(ErrorOf([&] { ReadGnssInsSimMotion(type_file); }),
             type_file.string() +
                 ":5: column 1 (command type): \"7\" is not allowed; allowed: 1, 2, 3, 4 or 5");
-  const std::filesystem::path number_file = kData / "bad_initial_number.csv";
+  const std::filesystem::path number_file = kTestData / "bad_initial_number.csv";
   EXPECT_EQ(ErrorOf([&] { ReadGnssInsSimMotion(number_file); }),
             number_file.string() +
                 ":2: column 8 (ini pitch (deg)): \"abc\" is not allowed; allowed: a finite number");
@@ -103,14 +94,15 @@ TEST(GnssInsSimMotion, BadFilesNameFileLineAndColumn) {
   EXPECT_EQ(from_text(head), "m.csv:3: no command lines; allowed: at least one motion command");
   EXPECT_NE(from_text("h\n95,120,0,0,0,0,0,0,0\nh\n1,0,0,0,0,0,0,5,1\n").find("m.csv:2: column 1"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([] { ReadGnssInsSimMotion(kData / "no_such_file.csv"); }).find("cannot open"),
-            std::string::npos);
+  EXPECT_NE(
+      ErrorOf([] { ReadGnssInsSimMotion(kTestData / "no_such_file.csv"); }).find("cannot open"),
+      std::string::npos);
 }
 
 TEST(GnssInsSimMotion, BlankCommandCellsAreZeroAsInGnssInsSim) {
   // gnss-ins-sim's own motion_def-static.csv before commit e7f1c68: `1,0,0,0,0,,,500,0`.
   const MotionSpec m =
-      ReadGnssInsSimMotion(kData / "gnss_ins_sim" / "motion_def-static-54b4415.csv");
+      ReadGnssInsSimMotion(kTestData / "gnss_ins_sim" / "motion_def-static-54b4415.csv");
   ASSERT_EQ(m.segments.size(), 1u);
   const auto& c = std::get<GnssInsSimCommand>(m.segments[0]);
   EXPECT_EQ(c.type, 1);
@@ -133,7 +125,7 @@ TEST(GnssInsSimMotion, BlankCommandCellsAreZeroAsInGnssInsSim) {
 }
 
 TEST(TruthProfile, ReadsGrovesLayoutWithOptionalHeader) {
-  const auto samples = ReadTruthProfile(kData / "groves_profile_header.csv");
+  const auto samples = ReadTruthProfile(kTestData / "groves_profile_header.csv");
   ASSERT_EQ(samples.size(), 3u);
   EXPECT_EQ(samples[1].t_s, 0.5);
   EXPECT_DOUBLE_EQ(samples[0].llh.lat_rad, 50.4249580 * kDeg);
@@ -146,7 +138,7 @@ TEST(TruthProfile, ReadsGrovesLayoutWithOptionalHeader) {
 }
 
 TEST(TruthProfile, BadFilesNameFileLineAndColumn) {
-  const std::filesystem::path file = kData / "bad_profile_time.csv";
+  const std::filesystem::path file = kTestData / "bad_profile_time.csv";
   EXPECT_EQ(ErrorOf([&] { ReadTruthProfile(file); }),
             file.string() +
                 ":3: column 1 (time (s)): \"0.1\" is not allowed; allowed: a time "

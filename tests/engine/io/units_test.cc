@@ -14,8 +14,6 @@
 namespace driftlab {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-
 // Relative difference in units of double epsilon (2.2e-16).
 double Ulps(double a, double b) {
   return std::abs(a - b) / (std::numeric_limits<double>::epsilon() * std::abs(b));

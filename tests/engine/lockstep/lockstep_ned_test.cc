@@ -19,8 +19,6 @@
 namespace driftlab {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-
 // Sets DRIFTLAB_ISA for the scope.
 class ScopedIsa {
  public:

@@ -13,12 +13,11 @@
 #include "driftlab/presets.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/trajectory.h"
+#include "support/imu_models.h"
 #include "support/motion_builders.h"
 
 namespace driftlab {
 namespace {
-
-constexpr double kDeg = M_PI / 180.0;
 
 // 10 s static, accelerate to 10 m/s, a 90 deg turn, 30 s straight, stop, 10 s static.
 MotionSpec ShortDrive() {
@@ -39,16 +38,7 @@ MotionSpec ShortDrive() {
   return m;
 }
 
-ImuErrorModel TacticalRepresentable() {
-  ImuErrorModel model = FindImuPreset("tactical");
-  for (TriadErrorParams* p : {&model.gyro, &model.accel}) {
-    p->bias_flicker = {};
-    p->scale_factor_sigma = 0.0;
-    p->misalignment_sigma_rad = 0.0;
-    p->range = 0.0;
-  }
-  return model;
-}
+using testing::TacticalRepresentable;
 
 MonteCarloSpec EkfSpec() {
   MonteCarloSpec spec;

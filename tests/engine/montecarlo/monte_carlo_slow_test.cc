@@ -54,7 +54,6 @@
 namespace driftlab {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
 constexpr uint32_t kRuns = 1000;
 
 struct Schuler {

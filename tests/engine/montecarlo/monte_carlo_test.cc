@@ -19,8 +19,6 @@
 namespace driftlab {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-
 // The shared small job (tests/support/small_monte_carlo_job.h).
 MonteCarloSpec SmallJob() { return testing::SmallMonteCarloJob(); }
 

@@ -19,10 +19,8 @@
 namespace driftlab {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-
 // testing::SmallMonteCarloJob with 4 runs, seed 7 and checkpoints at 25 s, 40 s and the end.
-MonteCarloSpec SmallJob() {
+MonteCarloSpec FourRunCheckpointJob() {
   MonteCarloSpec spec = testing::SmallMonteCarloJob();
   spec.runs = 4;
   spec.seed = 7;
@@ -63,11 +61,11 @@ void ExpectReplayScoresAsRunMonteCarlo(const MonteCarloSpec& spec) {
 }
 
 TEST(RunLoopTest, ReplayedFreeNedRunScoresAsRunMonteCarlo) {
-  ExpectReplayScoresAsRunMonteCarlo(SmallJob());
+  ExpectReplayScoresAsRunMonteCarlo(FourRunCheckpointJob());
 }
 
 TEST(RunLoopTest, ReplayedStaticAlignmentRunWithTruthHeightScoresAsRunMonteCarlo) {
-  MonteCarloSpec spec = SmallJob();
+  MonteCarloSpec spec = FourRunCheckpointJob();
   spec.initialization = InitializationKind::kStaticAlignment;
   spec.alignment.duration_s = 15.0;
   spec.initial_errors.attitude_rad = Vector3d::Zero();
@@ -76,7 +74,7 @@ TEST(RunLoopTest, ReplayedStaticAlignmentRunWithTruthHeightScoresAsRunMonteCarlo
 }
 
 TEST(RunLoopTest, ReplayedSeed000RunScoresAsRunMonteCarlo) {
-  MonteCarloSpec spec = SmallJob();
+  MonteCarloSpec spec = FourRunCheckpointJob();
   spec.simulation.mechanization = MechanizationKind::kSeed000;
   spec.simulation.seed000.static_period_s = 15.0;
   spec.initial_errors = InitialErrorSigmas();
@@ -89,7 +87,7 @@ TEST(RunLoopTest, ReplayedSeed000RunScoresAsRunMonteCarlo) {
 TEST(RunLoopTest, SimulationOfARunEqualsItsReplay) {
   for (const MechanizationKind mechanization :
        {MechanizationKind::kNed, MechanizationKind::kSeed000}) {
-    MonteCarloSpec spec = SmallJob();
+    MonteCarloSpec spec = FourRunCheckpointJob();
     spec.initial_errors = InitialErrorSigmas();
     spec.simulation.mechanization = mechanization;
     spec.simulation.seed000.static_period_s = 15.0;
@@ -132,7 +130,7 @@ TEST(RunLoopTest, SimulationOfARunEqualsItsReplay) {
 
 // The cancel flag set at sample 1500 stops the replay after the poll at sample 2048.
 TEST(RunLoopTest, ReplayStopsAtTheFirstPollAfterCancel) {
-  MonteCarloSpec spec = SmallJob();
+  MonteCarloSpec spec = FourRunCheckpointJob();
   spec.simulation.rate_hz = 100.0;  // 6000 samples
   std::atomic<bool> cancel{false};
   int64_t last_k = -1;

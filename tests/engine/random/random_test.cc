@@ -17,7 +17,7 @@ namespace {
 
 // Two-sided normal quantile for a false-alarm probability of 6.3e-5 per check: with the ~30
 // statistical checks in this file the chance that any fails for a correct generator is < 0.2 %.
-constexpr double kZ = 4.0;
+constexpr double kZ30Checks = 4.0;
 
 TEST(PhiloxTest, MatchesRandom123KnownAnswerVectors) {
   // Random123 1.09 kat_vectors, "philox4x32 10": counter[4] key[2] -> output[4].
@@ -152,7 +152,8 @@ std::vector<double> Draw(const RandomStream& stream, uint64_t first, size_t n) {
 
 TEST(GaussianTest, MomentsMatchStandardNormal) {
   // n = 1e7: standard errors of mean, variance, skewness, excess kurtosis are sqrt(1/n),
-  // sqrt(2/n), sqrt(6/n), sqrt(24/n) (normal theory); each is checked at kZ standard errors.
+  // sqrt(2/n), sqrt(6/n), sqrt(24/n) (normal theory); each is checked at kZ30Checks standard
+  // errors.
   const size_t n = 10'000'000;
   const std::vector<double> z =
       Draw(RandomStream(2024, 7, {SensorId::kGyro, 1, ErrorTerm::kWhiteNoise, 0}), 0, n);
@@ -169,10 +170,10 @@ TEST(GaussianTest, MomentsMatchStandardNormal) {
   const double var = static_cast<double>(m2 / nd) - mean * mean;
   const double skew = static_cast<double>(m3 / nd) / std::pow(var, 1.5);
   const double kurt = static_cast<double>(m4 / nd) / (var * var) - 3.0;
-  EXPECT_NEAR(mean, 0.0, kZ * std::sqrt(1.0 / nd));
-  EXPECT_NEAR(var, 1.0, kZ * std::sqrt(2.0 / nd));
-  EXPECT_NEAR(skew, 0.0, kZ * std::sqrt(6.0 / nd));
-  EXPECT_NEAR(kurt, 0.0, kZ * std::sqrt(24.0 / nd));
+  EXPECT_NEAR(mean, 0.0, kZ30Checks * std::sqrt(1.0 / nd));
+  EXPECT_NEAR(var, 1.0, kZ30Checks * std::sqrt(2.0 / nd));
+  EXPECT_NEAR(skew, 0.0, kZ30Checks * std::sqrt(6.0 / nd));
+  EXPECT_NEAR(kurt, 0.0, kZ30Checks * std::sqrt(24.0 / nd));
 }
 
 // 1e7 deviates of one stream, sorted, with their standard normal CDF values (the KS and
@@ -230,8 +231,8 @@ TEST(GaussianTest, AndersonDarlingAgainstStandardNormal) {
 
 TEST(GaussianTest, TailProbabilitiesMatchStandardNormal) {
   // Counts beyond |z| > 3 and > 4 are binomial(n, p) with p = erfc(3/sqrt2) = 2.700e-3 and
-  // erfc(4/sqrt2) = 6.334e-5; checked at kZ binomial standard deviations. Exercises the log in
-  // Box-Muller where u1 is small. Also |z| <= 6.67, the bound set by 32-bit uniforms.
+  // erfc(4/sqrt2) = 6.334e-5; checked at kZ30Checks binomial standard deviations. Exercises the log
+  // in Box-Muller where u1 is small. Also |z| <= 6.67, the bound set by 32-bit uniforms.
   const size_t n = 10'000'000;
   const std::vector<double> z =
       Draw(RandomStream(5, 3, {SensorId::kGyro, 0, ErrorTerm::kGaussMarkov, 0}), 0, n);
@@ -240,7 +241,8 @@ TEST(GaussianTest, TailProbabilitiesMatchStandardNormal) {
     const double count = static_cast<double>(
         std::count_if(z.begin(), z.end(), [&](double v) { return std::fabs(v) > threshold; }));
     const double nd = static_cast<double>(n);
-    EXPECT_NEAR(count, nd * p, kZ * std::sqrt(nd * p * (1 - p))) << "threshold " << threshold;
+    EXPECT_NEAR(count, nd * p, kZ30Checks * std::sqrt(nd * p * (1 - p)))
+        << "threshold " << threshold;
   }
   for (double v : z) ASSERT_LE(std::fabs(v), 6.67);
 }
@@ -265,7 +267,7 @@ TEST(RandomStreamTest, BlockFillIsIndependentOfSplitAndOrder) {
 using driftlab::testing::SampleCorrelation;
 
 TEST(RandomStreamTest, DifferentKeysGiveUncorrelatedStreams) {
-  // Sample correlation of independent streams: sd 1/sqrt(n); bound kZ / sqrt(n) per pair.
+  // Sample correlation of independent streams: sd 1/sqrt(n); bound kZ30Checks / sqrt(n) per pair.
   const size_t n = 200'000;
   const StreamKey base{SensorId::kGyro, 0, ErrorTerm::kWhiteNoise, 0};
   const std::vector<double> a = Draw(RandomStream(1, 0, base), 0, n);
@@ -278,7 +280,7 @@ TEST(RandomStreamTest, DifferentKeysGiveUncorrelatedStreams) {
       RandomStream(1, 0, {SensorId::kGyro, 0, ErrorTerm::kRandomWalk, 0}),   // term
       RandomStream(1, 0, {SensorId::kGyro, 0, ErrorTerm::kWhiteNoise, 1}),   // component
   };
-  const double bound = kZ / std::sqrt(static_cast<double>(n));
+  const double bound = kZ30Checks / std::sqrt(static_cast<double>(n));
   for (size_t s = 0; s < others.size(); ++s) {
     EXPECT_LT(std::fabs(SampleCorrelation(a, Draw(others[s], 0, n))), bound) << "pair " << s;
   }
@@ -294,7 +296,8 @@ TEST(RandomStreamTest, DifferentKeysGiveUncorrelatedStreams) {
     q0.push_back(a[i] * a[i]);
     q1.push_back(a[i + 1] * a[i + 1]);
   }
-  EXPECT_LT(std::fabs(SampleCorrelation(q0, q1)), kZ / std::sqrt(static_cast<double>(q0.size())));
+  EXPECT_LT(std::fabs(SampleCorrelation(q0, q1)),
+            kZ30Checks / std::sqrt(static_cast<double>(q0.size())));
 }
 
 TEST(RandomStreamTest, UniformDeviatesAreInOpenUnitIntervalWithMeanOneHalf) {
@@ -308,7 +311,7 @@ TEST(RandomStreamTest, UniformDeviatesAreInOpenUnitIntervalWithMeanOneHalf) {
     ASSERT_LT(v, 1.0);
     sum += v;
   }
-  EXPECT_NEAR(static_cast<double>(sum / n), 0.5, kZ * std::sqrt(1.0 / 12.0 / n));
+  EXPECT_NEAR(static_cast<double>(sum / n), 0.5, kZ30Checks * std::sqrt(1.0 / 12.0 / n));
 }
 
 }  // namespace

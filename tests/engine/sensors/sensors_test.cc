@@ -23,7 +23,7 @@ using Eigen::Vector3d;
 // Two-sided false-alarm probability per statistical check (z = 3.89): with ~20 checks in this
 // file a correct model fails one with probability < 0.2 %.
 constexpr double kAlpha = 1e-4;
-constexpr double kZ = 3.89;
+constexpr double kZ20Checks = 3.89;
 
 // Bounds on s^2 / sigma^2 for the mean of n squared N(0, sigma^2) deviates (chi-square, n dof).
 std::pair<double, double> VarianceRatioBounds(double n) {
@@ -185,7 +185,7 @@ using driftlab::testing::SampleCorrelation;
 
 TEST(SensorReproducibilityTest, DifferentRunsAxesAndSensorsHaveUncorrelatedNoise) {
   // White noise only: the sample correlation of independent series of n samples has sd
-  // 1/sqrt(n); each pair is checked at kZ / sqrt(n).
+  // 1/sqrt(n); each pair is checked at kZ20Checks / sqrt(n).
   ImuErrorModel model;
   model.gyro.white_noise_density = 1e-3;
   model.accel.white_noise_density = 2e-3;
@@ -204,7 +204,7 @@ TEST(SensorReproducibilityTest, DifferentRunsAxesAndSensorsHaveUncorrelatedNoise
     return out;
   };
   const auto run0 = series(0), run1 = series(1);
-  const double bound = kZ / std::sqrt(static_cast<double>(n));
+  const double bound = kZ20Checks / std::sqrt(static_cast<double>(n));
   EXPECT_LT(std::fabs(SampleCorrelation(run0[0], run1[0])), bound);  // gyro x, run 0 vs 1
   EXPECT_LT(std::fabs(SampleCorrelation(run0[3], run1[3])), bound);  // accel x, run 0 vs 1
   EXPECT_LT(std::fabs(SampleCorrelation(run0[0], run0[1])), bound);  // gyro x vs y
@@ -358,7 +358,7 @@ TEST(SensorNoiseTest, WhiteNoiseVarianceIsNSquaredDtForIncrementsAndNSquaredOver
 TEST(SensorNoiseTest, GaussMarkovAutocorrelationAtLagTauIsSigmaSquaredOverE) {
   // R independent runs; per run the product p = b(0) b(tau) of one axis pair, E p = sigma^2 / e,
   // Var p = sigma^4 (1 + e^-2) for jointly Gaussian (b0, b_tau) with correlation 1/e (Isserlis).
-  // The mean of R products is checked at kZ standard errors. Also E b(0)^2 = sigma^2
+  // The mean of R products is checked at kZ20Checks standard errors. Also E b(0)^2 = sigma^2
   // (stationary start), chi-square bounds on 3R squares.
   const double sigma = 3e-5, tau_s = 0.5, rate_hz = 100.0;
   ImuErrorModel model;
@@ -379,7 +379,8 @@ TEST(SensorNoiseTest, GaussMarkovAutocorrelationAtLagTauIsSigmaSquaredOverE) {
   const double n = 3.0 * runs;
   const double mean_product = static_cast<double>(sum_products / n);
   const double s2 = sigma * sigma;
-  EXPECT_NEAR(mean_product, s2 / std::numbers::e, kZ * s2 * std::sqrt((1.0 + std::exp(-2.0)) / n));
+  EXPECT_NEAR(mean_product, s2 / std::numbers::e,
+              kZ20Checks * s2 * std::sqrt((1.0 + std::exp(-2.0)) / n));
   const auto [lo, hi] = VarianceRatioBounds(n);
   const double ratio = static_cast<double>(sum_initial_squares / n) / s2;
   EXPECT_GT(ratio, lo);
@@ -468,9 +469,9 @@ TEST(SensorNoiseTest, GaussMarkovIncrementHasExactIntegralVarianceEvenForDtNearT
   EXPECT_GT(m.mean_square / expected, lo);
   EXPECT_LT(m.mean_square / expected, hi);
   // Lag-1 covariance of increments: sigma^2 T^2 (1 - e^-x)^2. Var of a product of two correlated
-  // Gaussians <= (1 + rho^2) v^2 <= 2 v^2 (v = increment variance): kZ sqrt(2/n) v bound.
+  // Gaussians <= (1 + rho^2) v^2 <= 2 v^2 (v = increment variance): kZ20Checks sqrt(2/n) v bound.
   const double expected_cov = sigma * sigma * tau_s * tau_s * std::pow(1 - std::exp(-x), 2);
-  EXPECT_NEAR(m.mean_lag1, expected_cov, kZ * std::sqrt(2.0 / n) * expected);
+  EXPECT_NEAR(m.mean_lag1, expected_cov, kZ20Checks * std::sqrt(2.0 / n) * expected);
 }
 
 TEST(SensorNoiseTest, RandomWalkIncrementVarianceIsKSquaredHCubedOverThree) {
@@ -527,7 +528,7 @@ TEST(SensorNoiseTest, WhiteGaussMarkovAndRandomWalkTogetherKeepEachTermsIncremen
   EXPECT_LT(m.mean_square / expected, hi);
   const double expected_cov =
       sigma * sigma * tau_s * tau_s * std::pow(1 - std::exp(-x), 2) + K * K * h * h * h / 2.0;
-  EXPECT_NEAR(m.mean_lag1, expected_cov, kZ * std::sqrt(2.0 / n) * expected);
+  EXPECT_NEAR(m.mean_lag1, expected_cov, kZ20Checks * std::sqrt(2.0 / n) * expected);
 }
 
 TEST(SensorNoiseTest, TurnOnBiasAndRandomScaleFactorSpreadAcrossRunsMatchSigma) {

@@ -20,9 +20,6 @@
 namespace driftlab {
 namespace {
 
-constexpr double kDeg = M_PI / 180.0;
-const std::filesystem::path kData = std::filesystem::path(DRIFTLAB_SOURCE_DIR) / "tests" / "data";
-
 MotionSpec Motion(EarthModel model, double lat_deg, const Vector3d& v_eb_n, double yaw_deg,
                   double pitch_deg = 0.0, double roll_deg = 0.0) {
   MotionSpec m;
@@ -229,8 +226,8 @@ void Check90DegreeTurn(const std::filesystem::path& file) {
 }
 
 TEST(TrajectoryGenerator, GnssInsSim90DegreeTurnFileStartsAt315AndEndsAtYaw45Degrees) {
-  Check90DegreeTurn(kData / "gnss_ins_sim_90deg_turn.csv");
-  Check90DegreeTurn(kData / "gnss_ins_sim" / "motion_def-90deg_turn.csv");  // the tool's own
+  Check90DegreeTurn(kTestData / "gnss_ins_sim_90deg_turn.csv");
+  Check90DegreeTurn(kTestData / "gnss_ins_sim" / "motion_def-90deg_turn.csv");  // the tool's own
 }
 
 // Reference values: gnss-ins-sim's own pathgen.path_gen() (github.com/Aceinna/gnss-ins-sim, commit
@@ -343,7 +340,7 @@ void CheckAgainstGnssInsSim(const std::filesystem::path& file, const GnssInsSimR
 
 TEST(TrajectoryGenerator, GnssInsSimDemoFilesMatchItsOwnTrajectory) {
   for (const GnssInsSimReference& r : kGnssInsSimReferences) {
-    CheckAgainstGnssInsSim(kData / "gnss_ins_sim" / r.file, r);
+    CheckAgainstGnssInsSim(kTestData / "gnss_ins_sim" / r.file, r);
   }
   if (const char* dir = std::getenv("DRIFTLAB_GNSS_INS_SIM_DIR")) {
     for (const GnssInsSimReference& r : kGnssInsSimKomatsuReferences) {
@@ -356,7 +353,7 @@ TEST(TrajectoryGenerator, GnssInsSimType1CommandPassesAFirstOrderLowPass) {
   // motion_def-0to100.csv: a 10 m/s^2 command for 10 s from rest. The filtered acceleration of step
   // k (k = 0, 1, ...) is a_k = 10 (1 - 0.9^(k+1)), so after n = 999 recorded steps of dt = 0.01 s
   //   v = dt sum_{k<n} a_k = 0.1 (n - 0.9 (1 - 0.9^n) / 0.1) = 0.1 n - 0.9 (1 - 0.9^n).
-  const MotionSpec m = ReadGnssInsSimMotion(kData / "gnss_ins_sim" / "motion_def-0to100.csv");
+  const MotionSpec m = ReadGnssInsSimMotion(kTestData / "gnss_ins_sim" / "motion_def-0to100.csv");
   TrajectoryGenerator g(m, 100.0);
   const Sums s = SumIncrements(g);
   const double n = 999.0;

@@ -26,6 +26,7 @@
 #include "driftlab/spec_error.h"
 #include "driftlab/units.h"
 #include "job/field_checks.h"
+#include "text.h"
 
 namespace driftlab::app {
 namespace {
@@ -64,17 +65,6 @@ std::vector<std::string> Split(std::string_view line, char sep) {
   return {views.begin(), views.end()};
 }
 
-std::string Join(const std::vector<std::string>& items) {
-  std::string out;
-  for (const std::string& item : items) out += (out.empty() ? "" : ", ") + item;
-  return out;
-}
-
-bool ParseNumber(std::string_view text, double* value) {
-  const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), *value);
-  return !text.empty() && ec == std::errc() && ptr == text.data() + text.size();
-}
-
 // The reader behind both ReadNumericCsv overloads; `selected` empty = every column.
 NumericTable ReadCsv(const std::string& path, const std::vector<std::string>* selected,
                      const std::string& columns_field) {
@@ -96,7 +86,7 @@ NumericTable ReadCsv(const std::string& path, const std::vector<std::string>* se
     bool numeric = true;
     for (std::string_view f : fields) {
       double v = 0.0;
-      numeric = numeric && ParseNumber(f, &v);
+      numeric = numeric && ParseWholeNumber(f, &v);
     }
     if (numeric && selected == nullptr) {
       for (size_t i = 0; i < fields.size(); ++i) header.push_back(fmt::format("column{}", i + 1));
@@ -134,7 +124,7 @@ NumericTable ReadCsv(const std::string& path, const std::vector<std::string>* se
       const auto it = std::find(header.begin(), header.end(), name);
       if (it == header.end()) {
         throw SpecError(columns_field, "'" + name + "'",
-                        "a column of " + path + ": " + Join(header));
+                        "a column of " + path + ": " + Join(header, ", "));
       }
       take.push_back(static_cast<size_t>(it - header.begin()));
     }
@@ -142,16 +132,16 @@ NumericTable ReadCsv(const std::string& path, const std::vector<std::string>* se
   for (size_t i : take) table.columns.push_back(header[i]);
   const auto parse_row = [&](size_t row_line) {
     if (fields.size() != header.size()) {
-      throw SpecError(
-          fmt::format("{}:{}", path, row_line),
-          fmt::format("{} columns; expected {} ({} fields where the header has {} "
-                      "fields: {})",
-                      fields.size(), header.size(), fields.size(), header.size(), Join(header)),
-          0);
+      throw SpecError(fmt::format("{}:{}", path, row_line),
+                      fmt::format("{} columns; expected {} ({} fields where the header has {} "
+                                  "fields: {})",
+                                  fields.size(), header.size(), fields.size(), header.size(),
+                                  Join(header, ", ")),
+                      0);
     }
     for (size_t i : take) {
       double value = 0.0;
-      if (!ParseNumber(fields[i], &value) || !std::isfinite(value)) {
+      if (!ParseWholeNumber(fields[i], &value) || !std::isfinite(value)) {
         throw SpecError(fmt::format("{}:{}: column '{}'", path, row_line, header[i]),
                         "'" + std::string(fields[i]) + "'", "a finite number");
       }
@@ -287,12 +277,12 @@ NumericTable SelectColumns(const NumericTable& table, const std::vector<std::str
     if (!missing.empty() || !extra.empty()) {
       throw SpecError(
           "data: header",
-          fmt::format("{}{}{}", Join(table.columns),
-                      missing.empty() ? "" : " (missing " + Join(missing) + ")",
-                      extra.empty() ? "" : " (unknown " + Join(extra) + ")"),
+          fmt::format("{}{}{}", Join(table.columns, ", "),
+                      missing.empty() ? "" : " (missing " + Join(missing, ", ") + ")",
+                      extra.empty() ? "" : " (unknown " + Join(extra, ", ") + ")"),
           fmt::format("a header naming the columns {} ({}), in any order; or no header, the "
                       "columns in that order",
-                      Join(expected), units));
+                      Join(expected, ", "), units));
     }
   }
   NumericTable out;
@@ -511,12 +501,12 @@ struct TermUnits {
   const char* quantization;
   const char* ramp;
 };
-constexpr TermUnits kGyroUnits{"rad/sqrt(s)", "rad/s", "rad/s/sqrt(s)", "rad", "rad/s^2"};
-constexpr TermUnits kAccelUnits{"m/s/sqrt(s)", "m/s^2", "m/s^2/sqrt(s)", "m/s", "m/s^3"};
+constexpr TermUnits kGyroTermUnits{"rad/sqrt(s)", "rad/s", "rad/s/sqrt(s)", "rad", "rad/s^2"};
+constexpr TermUnits kAccelTermUnits{"m/s/sqrt(s)", "m/s^2", "m/s^2/sqrt(s)", "m/s", "m/s^3"};
 
 void AddTerms(const calib::NoiseFitResult& fit, bool gyro, const std::string& axis,
               const TriadErrorParams* datasheet, v1::NoiseModelFit* out) {
-  const TermUnits& u = gyro ? kGyroUnits : kAccelUnits;
+  const TermUnits& u = gyro ? kGyroTermUnits : kAccelTermUnits;
   const bool gm = fit.bias_model == calib::BiasModel::kGaussMarkov;
   struct Row {
     const char* name;
@@ -612,7 +602,7 @@ std::vector<RateColumn> SelectRateColumns(const NumericTable& table,
       const long index = find(name);
       if (index < 0) {
         throw SpecError(columns_field, name.empty() ? "''" : "'" + name + "'",
-                        "a column of " + data_name + ": " + Join(table.columns));
+                        "a column of " + data_name + ": " + Join(table.columns, ", "));
       }
       chosen.emplace_back(name, static_cast<size_t>(index));
     }

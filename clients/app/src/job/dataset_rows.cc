@@ -9,13 +9,12 @@
 #include <utility>
 
 #include "driftlab/spec_error.h"
+#include "driftlab/units.h"
 
 namespace driftlab::app {
 namespace {
 
 // Degrees at the API edge (as translate.cc converts job angles).
-constexpr double kDegToRad = M_PI / 180.0;
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 enum NavigationColumn { kT = 0, kLat, kLon, kHeight, kVn, kVe, kVd, kRoll, kPitch, kYaw };
 

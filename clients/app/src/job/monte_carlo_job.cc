@@ -19,12 +19,12 @@
 #include "driftlab/sensors.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/trajectory.h"
+#include "driftlab/units.h"
 #include "job/field_checks.h"
 
 namespace driftlab::app {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
 // Limits of the initial errors: beyond them the linear error models (and a real INS's
 // initialisation) make no sense.
 constexpr double kMaxInitialPosition_m = 1.0e5;

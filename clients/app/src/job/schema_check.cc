@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "driftlab/spec_error.h"
+#include "text.h"
 
 namespace driftlab::app {
 namespace {
@@ -19,13 +20,7 @@ using google::protobuf::EnumDescriptor;
 using google::protobuf::FieldDescriptor;
 using google::protobuf::Value;
 
-std::string Join(const std::vector<std::string>& items, std::string_view separator) {
-  std::string out;
-  for (const std::string& item : items) {
-    if (!out.empty()) out += separator;
-    out += item;
-  }
-  return out;
+return out;
 }
 
 std::string FieldNames(const Descriptor& descriptor) {
@@ -79,13 +74,6 @@ const FieldDescriptor* FindField(const Descriptor& descriptor, const std::string
   return nullptr;
 }
 
-// Parses the whole string as a number (the JSON mapping accepts numeric strings).
-bool ParseNumber(const std::string& text, double* out) {
-  const char* end = text.data() + text.size();
-  auto [ptr, ec] = std::from_chars(text.data(), end, *out);
-  return ec == std::errc() && ptr == end && !text.empty();
-}
-
 std::string IntegerRange(const FieldDescriptor& field) {
   switch (field.cpp_type()) {
     case FieldDescriptor::CPPTYPE_INT32:
@@ -133,7 +121,7 @@ void CheckSingle(const Value& value, const FieldDescriptor& field, const std::st
       if (value.kind_case() == Value::kNumberValue) return;
       if (value.kind_case() == Value::kStringValue) {
         const std::string& s = value.string_value();
-        if (s == "NaN" || s == "Infinity" || s == "-Infinity" || ParseNumber(s, &x)) return;
+        if (s == "NaN" || s == "Infinity" || s == "-Infinity" || ParseWholeNumber(s, &x)) return;
       }
       throw SpecError(path, Describe(value), "a number");
     }
@@ -146,7 +134,7 @@ void CheckSingle(const Value& value, const FieldDescriptor& field, const std::st
       if (value.kind_case() == Value::kNumberValue) {
         ok = IntegerInRange(field, value.number_value());
       } else if (value.kind_case() == Value::kStringValue) {
-        ok = ParseNumber(value.string_value(), &x) && IntegerInRange(field, x);
+        ok = ParseWholeNumber(value.string_value(), &x) && IntegerInRange(field, x);
       }
       if (!ok) throw SpecError(path, Describe(value), IntegerRange(field));
       return;

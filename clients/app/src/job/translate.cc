@@ -10,12 +10,11 @@
 #include "driftlab/io.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/trajectory.h"
+#include "driftlab/units.h"
 #include "job/field_checks.h"
 
 namespace driftlab::app {
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 // Allowed ranges of the job's numbers. The physical limits come from the engine (rate and
 // duration, trajectory.h) or from the vehicles driftlab models; they are wide enough for any real

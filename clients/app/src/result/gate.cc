@@ -12,12 +12,12 @@
 #include "driftlab/app/gate_statistics.h"
 #include "driftlab/app/result_file.h"
 #include "driftlab/spec_error.h"
+#include "result/gate_text.h"
 
 namespace driftlab::app {
 namespace {
 
 // Shortest text that reads back to the same double (fmt's default for doubles).
-std::string TimeText(double t_s) { return fmt::format("{}", t_s); }
 
 // Appends a metric unless it is NaN (sigma of a one-run result: undefined, not gated).
 void Add(Metric metric, std::vector<Metric>& out) {
@@ -44,8 +44,6 @@ void AddCheckpointMetrics(const std::string& prefix, const v1::Checkpoint& check
   Add({prefix + "p95", p.p95(), MetricKind::kQuantile, c, -1, k, 0.95, unit}, out);
   Add({prefix + "p99", p.p99(), MetricKind::kQuantile, c, -1, k, 0.99, unit}, out);
 }
-
-std::string Number(double value) { return fmt::format("{:.6g}", value); }
 
 std::string Key(int c) { return ComponentKey(static_cast<v1::ErrorComponent>(c + 1)); }
 
@@ -222,13 +220,14 @@ std::vector<Metric> ListMetrics(const v1::JobResult& result) {
     }
   }
   for (int e = 0; e < result.epochs_size(); ++e) {
-    const std::string selector = "epoch[t=" + TimeText(result.epochs(e).t_s()) + "].";
+    const std::string selector = "epoch[t=" + MetricTimeText(result.epochs(e).t_s()) + "].";
     for (int c = 0; c < kErrorComponentCount; ++c) {
       AddEpochMetrics(selector + Key(c) + ".", result.epochs(e), e, c, metrics);
     }
   }
   for (int k = 0; k < result.checkpoints_size(); ++k) {
-    const std::string selector = "checkpoint[t=" + TimeText(result.checkpoints(k).t_s()) + "].";
+    const std::string selector =
+        "checkpoint[t=" + MetricTimeText(result.checkpoints(k).t_s()) + "].";
     for (int c = 0; c < kErrorComponentCount; ++c) {
       AddCheckpointMetrics(selector + Key(c) + ".", result.checkpoints(k), k, c, metrics);
     }
@@ -376,9 +375,9 @@ GateReport RunGate(const v1::JobResult& baseline, const v1::JobResult& current,
     const double limit_ratio = row.limit / row.baseline;
     if (rejected[t]) {
       row.decision = GateDecision::kRegression;
-      row.note =
-          fmt::format("current {} > limit {} (baseline {}), p = {:.2g} ({})", Number(row.current),
-                      Number(row.limit), Number(row.baseline), row.p_value, row.test);
+      row.note = fmt::format("current {} > limit {} (baseline {}), p = {:.2g} ({})",
+                             GateNumberText(row.current), GateNumberText(row.limit),
+                             GateNumberText(row.baseline), row.p_value, row.test);
     } else if (std::isnan(row.ratio)) {
       row.decision = GateDecision::kPass;  // exact comparison within the limit
     } else if (row.ratio_high < 1.0) {
@@ -388,7 +387,8 @@ GateReport RunGate(const v1::JobResult& baseline, const v1::JobResult& current,
     } else {
       row.decision = GateDecision::kInconclusive;
       row.note = fmt::format("interval of current/baseline [{}, {}] straddles the limit {}",
-                             Number(row.ratio_low), Number(row.ratio_high), Number(limit_ratio));
+                             GateNumberText(row.ratio_low), GateNumberText(row.ratio_high),
+                             GateNumberText(limit_ratio));
     }
   }
   for (const GateRow& row : report.rows) {

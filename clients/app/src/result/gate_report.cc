@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "driftlab/app/gate.h"
+#include "result/gate_text.h"
 
 namespace driftlab::app {
 namespace {
@@ -43,8 +44,6 @@ std::string EscapeXml(std::string_view text) {
   }
   return out;
 }
-
-std::string Number(double value) { return fmt::format("{:.6g}", value); }
 
 // "1.04 [0.93, 1.17]" (ratio and its interval); "-" when there is none.
 std::string RatioText(const GateRow& row) {
@@ -98,8 +97,8 @@ std::string FormatGateTable(const GateReport& report) {
   std::vector<std::string> failed;
   for (const GateRow& row : report.rows) {
     out += fmt::format("{:<{}}  {:<4}  {:>11}  {:>11}  {:<26}  {:>6}  {:<12}  {}\n", row.metric,
-                       width, row.unit, Number(row.baseline), Number(row.current), RatioText(row),
-                       LimitRatioText(row), DecisionName(row.decision), row.test);
+                       width, row.unit, GateNumberText(row.baseline), GateNumberText(row.current),
+                       RatioText(row), LimitRatioText(row), DecisionName(row.decision), row.test);
     if (Fails(report, row)) failed.push_back(row.metric);
   }
   out += fmt::format(
@@ -148,9 +147,9 @@ std::string RenderJunitXml(const GateReport& report) {
     const std::string detail = fmt::format(
         "{}: baseline {} {unit}, current {} {unit}, ratio {} (interval at {:g} %), limit ratio {}, "
         "p = {:.3g} before Holm; test: {}; baseline file {}, current file {}",
-        DecisionName(row.decision), Number(row.baseline), Number(row.current), RatioText(row),
-        100.0 * (1.0 - report.options.alpha), LimitRatioText(row), row.p_value, row.test,
-        report.baseline_file, report.current_file, fmt::arg("unit", row.unit));
+        DecisionName(row.decision), GateNumberText(row.baseline), GateNumberText(row.current),
+        RatioText(row), 100.0 * (1.0 - report.options.alpha), LimitRatioText(row), row.p_value,
+        row.test, report.baseline_file, report.current_file, fmt::arg("unit", row.unit));
     out += fmt::format("  <testcase classname=\"driftlab.gate\" name=\"{}\" time=\"{:.6f}\"",
                        EscapeXml(row.metric), row.wall_s);
     if (!Fails(report, row)) {

@@ -11,13 +11,13 @@
 #include "driftlab/app/gate.h"
 #include "driftlab/input_files.h"
 #include "driftlab/spec_error.h"
+#include "result/gate_text.h"
 
 namespace driftlab::app {
 namespace {
 
 // Shortest text that reads back to the same double (fmt's default for doubles), as ListMetrics
 // prints times.
-std::string TimeText(double t_s) { return fmt::format("{}", t_s); }
 
 // Rewrites every "[t=NUMBER]" of a pattern without wildcards inside the brackets to the form
 // ListMetrics prints, so that "epoch[t=600.0]" names "epoch[t=600]".
@@ -35,7 +35,7 @@ std::string NormalizePattern(const std::string& pattern) {
     const double t_s = std::strtod(number.c_str(), &end);
     const bool plain = !number.empty() && number.find_first_of("*?") == std::string::npos &&
                        end == number.c_str() + number.size() && std::isfinite(t_s);
-    out += plain ? TimeText(t_s) : number;
+    out += plain ? MetricTimeText(t_s) : number;
     out += ']';
     i = close + 1;
   }

@@ -13,12 +13,11 @@
 #include "driftlab/app/result_check.h"
 #include "driftlab/ins_gnss_filter.h"
 #include "driftlab/spec_error.h"
+#include "driftlab/units.h"
 
 namespace driftlab::app {
 namespace {
 
-constexpr double kDegToRad = M_PI / 180.0;
-constexpr double kRadToDeg = 180.0 / M_PI;
 constexpr char kMergeEncoding[] = "driftlab.exact_sum.v1";
 
 // The engine's component index (mc_statistics.h) <-> the result's enum (result.proto): the same
