@@ -29,10 +29,11 @@ class ServerProcess:
         tmp = pathlib.Path(self._scratch.name)
         port_file = tmp / "port"
         self.log_path = tmp / "server.log"
-        self.process = subprocess.Popen(
-            [self.binary, "--listen", "127.0.0.1:0", "--data", str(tmp / "data"),
-             "--port-file", str(port_file), *self.extra_args],
-            stdout=open(self.log_path, "w"), stderr=subprocess.STDOUT)
+        with open(self.log_path, "w") as log:
+            self.process = subprocess.Popen(
+                [self.binary, "--listen", "127.0.0.1:0", "--data", str(tmp / "data"),
+                 "--port-file", str(port_file), *self.extra_args],
+                stdout=log, stderr=subprocess.STDOUT)
         deadline = time.monotonic() + START_TIMEOUT_S
         port = None
         while time.monotonic() < deadline:
