@@ -27,7 +27,11 @@ std::vector<std::string> CommandNames(const std::string& overview) {
   while (std::getline(in, line)) {
     std::istringstream words(line);
     std::string name;
-    if (line.rfind("  ", 0) == 0 && words >> name) names.push_back(name);
+    // A command's line starts with two blanks and its name; a description's continuation lines
+    // start with more.
+    if (line.size() > 2 && line.rfind("  ", 0) == 0 && line[2] != ' ' && words >> name) {
+      names.push_back(name);
+    }
   }
   return names;
 }
@@ -146,7 +150,7 @@ TEST(CompletionCli, BashCompletesCommandsOptionsAndValues) {
   EXPECT_EQ(Complete(scratch, script, {"driftlab", "ru"}), V({"run"}));
   EXPECT_EQ(Complete(scratch, script, {"driftlab", "re"}), V({"report", "result"}));
   EXPECT_EQ(Complete(scratch, script, {"driftlab", "run", "--rep"}), V({"--report"}));
-  EXPECT_EQ(Complete(scratch, script, {"driftlab", "-q", "run", "--th"}), V({"--threads"}));
+  EXPECT_EQ(Complete(scratch, script, {"driftlab", "run", "-q", "--th"}), V({"--threads"}));
   EXPECT_EQ(Complete(scratch, script, {"driftlab", "calibrate", "--loss", ""}),
             V({"cauchy", "huber", "none"}));
   EXPECT_EQ(Complete(scratch, script, {"driftlab", "help", "val"}), V({"validate"}));
