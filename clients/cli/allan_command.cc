@@ -85,9 +85,6 @@ constexpr DisplayUnits kAccelDisplayMg{
 
 using Column = app::RateColumn;
 
-return out;
-}
-
 // Reads `path` (calibration_job.h ReadNumericCsv) and selects the columns as SI rates.
 std::vector<Column> ReadColumns(const AllanCliOptions& options) {
   const app::NumericTable table = app::ReadNumericCsv(options.data_path);
