@@ -18,7 +18,7 @@
 #include "driftlab/spec_error.h"
 #include "driftlab/trajectory.h"
 #include "support/bonferroni_checks.h"
-#include "support/imu_models.h"
+#include "support/ins_gnss_scenarios.h"
 #include "support/motion_builders.h"
 
 namespace driftlab {
