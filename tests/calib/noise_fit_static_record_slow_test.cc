@@ -10,8 +10,9 @@
 //  * every term the preset has (white noise N, bias instability B) is kept by the selection test
 //    (noise_fit.h) and the preset value lies inside the fit's 99.9 % interval (z = 3.29 on the
 //    variance coefficient, as the 95 % interval is built) -- except a B whose flicker floor no
-//    record can show (Case::floor_visible): kept and inside, or "not determined" with a 95 % upper
-//    bound that covers the preset value (at most the binomial 99.9 % quantile of seeds may not);
+//    record can show (FloorCase::floor_visible): kept and inside, or "not determined" with a 95 %
+//    upper bound that covers the preset value (at most the binomial 99.9 % quantile of seeds may
+//    not);
 //  * no term the preset lacks (quantization, random walk, rate ramp) is reported present.
 // Asserted over all seeds: the number of preset values outside their 95 % interval is at most
 // the binomial(n, 0.05) 99.9 % quantile (n = 2 terms x 2 triads x seeds x presets).
@@ -66,18 +67,18 @@ constexpr std::array<uint64_t, 10> kSeedList = {11, 23, 37, 41, 59, 61, 73, 89, 
 constexpr double kRateHz = 100.0;
 constexpr double kDurationS = 7200.0;
 
-struct Record {
+struct StaticRecord {
   std::array<std::vector<double>, 3> gyro;   // omega_ib_b [rad/s]
   std::array<std::vector<double>, 3> accel;  // f_ib_b [m/s^2]
 };
 
-Record SimulateStatic(const ImuErrorModel& model, uint64_t seed) {
+StaticRecord SimulateStatic(const ImuErrorModel& model, uint64_t seed) {
   SimulationSpec spec;
   spec.rate_hz = kRateHz;
   spec.motion.initial.llh = {45.0 * M_PI / 180.0, 0.0, 0.0};
   spec.motion.segments.push_back(StaticSegment{kDurationS});
   const SensorRun sensor{model, seed, 0};
-  Record r;
+  StaticRecord r;
   RunSimulation(spec, &sensor, [&](const SimulationStep& step) {
     for (int a = 0; a < 3; ++a) {
       r.gyro[a].push_back(step.measured_sample->omega_ib_b[a]);
@@ -104,7 +105,7 @@ int BinomialQuantile(int n, double p, double q) {
   return k;
 }
 
-struct Case {
+struct FloorCase {
   const char* preset;
   bool gyro;
   bool accel;
@@ -115,10 +116,10 @@ struct Case {
   bool floor_visible = true;
 };
 
-void CheckPresets(const std::vector<Case>& cases) {
+void CheckPresets(const std::vector<FloorCase>& cases) {
   const auto start = std::chrono::steady_clock::now();
   int checks = 0, outside_95 = 0;
-  for (const Case& c : cases) {
+  for (const FloorCase& c : cases) {
     const char* name = c.preset;
     const ImuErrorModel& preset = FindImuPreset(name);
     struct Summary {
@@ -129,7 +130,7 @@ void CheckPresets(const std::vector<Case>& cases) {
     };
     std::array<Summary, 2> summary;  // gyro, accel
     for (int s = 0; s < kSeeds; ++s) {
-      const Record record = SimulateStatic(preset, kSeedList[s]);
+      const StaticRecord record = SimulateStatic(preset, kSeedList[s]);
       for (const bool gyro : {true, false}) {
         if (!(gyro ? c.gyro : c.accel)) continue;
         const TriadErrorParams& truth = gyro ? preset.gyro : preset.accel;

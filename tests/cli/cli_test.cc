@@ -95,7 +95,7 @@ struct BadJob {
   std::string message;
 };
 
-class BadJobFile : public testing::TestWithParam<BadJob> {};
+class BadJobFile : public ::testing::TestWithParam<BadJob> {};
 
 TEST_P(BadJobFile, IsRejectedWithOneMessageAndNothingWritten) {
   Scratch scratch;
@@ -114,7 +114,7 @@ TEST_P(BadJobFile, IsRejectedWithOneMessageAndNothingWritten) {
 
 INSTANTIATE_TEST_SUITE_P(
     Cli, BadJobFile,
-    testing::Values(
+    ::testing::Values(
         BadJob{"bad_unknown_segment.json",
                "motion.segments[2].spin: unknown field; allowed: static, accelerate, "
                "constant_velocity, turn, climb, zigzag, ship_motion, figure_eight"},
@@ -132,7 +132,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadJob{"bad_enum.yaml",
                "navigation.mechanization: \"INS\" is not allowed; allowed: NED, SEED000"},
         BadJob{"bad_type.json", "rate_hz: \"fast\" is not allowed; allowed: a number"}),
-    [](const testing::TestParamInfo<BadJob>& info) {
+    [](const ::testing::TestParamInfo<BadJob>& info) {
       std::string name = info.param.file;
       for (char& c : name) {
         if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';

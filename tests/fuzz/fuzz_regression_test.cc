@@ -53,7 +53,7 @@ void Replay(const FuzzTarget& target, const fs::path& file) {
   }
 }
 
-class FuzzInputs : public testing::TestWithParam<FuzzTarget> {};
+class FuzzInputs : public ::testing::TestWithParam<FuzzTarget> {};
 
 TEST_P(FuzzInputs, SeedCorpusIsPresentAndReplaysCleanly) {
   const fs::path dir = fs::path(DRIFTLAB_SOURCE_DIR) / "fuzz" / "corpus" / GetParam().name;
@@ -67,8 +67,8 @@ TEST_P(FuzzInputs, EveryRegressionReplaysCleanly) {
   for (const fs::path& file : FilesIn(dir)) Replay(GetParam(), file);
 }
 
-INSTANTIATE_TEST_SUITE_P(Targets, FuzzInputs, testing::ValuesIn(FuzzTargets()),
-                         [](const testing::TestParamInfo<FuzzTarget>& info) {
+INSTANTIATE_TEST_SUITE_P(Targets, FuzzInputs, ::testing::ValuesIn(FuzzTargets()),
+                         [](const ::testing::TestParamInfo<FuzzTarget>& info) {
                            return std::string(info.param.name);
                          });
 

@@ -257,7 +257,7 @@ struct RangeCase {
   std::string message;
 };
 
-class OutOfRange : public testing::TestWithParam<RangeCase> {};
+class OutOfRange : public ::testing::TestWithParam<RangeCase> {};
 
 TEST_P(OutOfRange, MessageNamesThePathTheValueAndTheAllowedRange) {
   EXPECT_EQ(JsonError(GetParam().job), GetParam().message);
@@ -265,7 +265,7 @@ TEST_P(OutOfRange, MessageNamesThePathTheValueAndTheAllowedRange) {
 
 INSTANTIATE_TEST_SUITE_P(
     JobSpec, OutOfRange,
-    testing::Values(
+    ::testing::Values(
         RangeCase{JobWithSegments(R"({"static": {"duration_s": -5}})"),
                   "motion.segments[0].static.duration_s: -5 is not allowed; allowed: 0 < "
                   "duration_s <= 100000 s"},
