@@ -11,6 +11,7 @@ packages=(
   libeigen3-dev libceres-dev libtbb-dev
   libprotobuf-dev protobuf-compiler libgrpc++-dev protobuf-compiler-grpc
   libyaml-cpp-dev libcli11-dev libfmt-dev libspdlog-dev libsqlite3-dev libssl-dev openssl
+  libcpp-httplib-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   python3-grpcio python3-protobuf python3-matplotlib python3-numpy
   clang-format ccache
