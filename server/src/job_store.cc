@@ -57,6 +57,15 @@ constexpr const char* kColumns =
     "seq, id, owner, state, request, name, runs_total, samples_total, error, submitted_unix_s, "
     "started_unix_s, finished_unix_s, deadline_unix_s, attempts, result IS NOT NULL, cluster";
 
+// "SELECT <columns><rest>", built by appending (GCC 12 warns falsely, -Warray-bounds, about
+// std::string("...") + const char* + "..." chains inlined here).
+std::string Select(const char* columns, const char* rest) {
+  std::string sql = "SELECT ";
+  sql.append(columns);
+  sql.append(rest);
+  return sql;
+}
+
 // A prepared statement, finalized on scope exit.
 class Statement {
  public:
@@ -227,7 +236,7 @@ void JobStore::Insert(StoredJob* job) {
 
 std::optional<StoredJob> JobStore::Get(const std::string& id) const {
   std::lock_guard lock(mutex_);
-  Statement s(db_, std::string("SELECT ") + kColumns + " FROM jobs WHERE id = ?");
+  Statement s(db_, Select(kColumns, " FROM jobs WHERE id = ?"));
   s.Bind(1, id);
   if (!s.Step()) return std::nullopt;
   return ReadRow(s);
@@ -292,7 +301,7 @@ std::vector<StoredJob> JobStore::RecoverQueued() {
     s.Bind(1, int64_t{v1::QUEUED}).Bind(2, int64_t{v1::RUNNING});
     s.Step();
   }
-  Statement s(db_, std::string("SELECT ") + kColumns + " FROM jobs WHERE state = ? ORDER BY seq");
+  Statement s(db_, Select(kColumns, " FROM jobs WHERE state = ? ORDER BY seq"));
   s.Bind(1, int64_t{v1::QUEUED});
   std::vector<StoredJob> jobs;
   while (s.Step()) jobs.push_back(ReadRow(s));
@@ -317,7 +326,7 @@ std::optional<std::string> JobStore::GetResult(const std::string& id) const {
 std::vector<StoredJob> JobStore::List(const std::string& owner,
                                       const std::vector<v1::JobState>& states, int64_t before_seq,
                                       uint32_t limit, const std::string& name_contains) const {
-  std::string sql = std::string("SELECT ") + kColumns + " FROM jobs WHERE owner = ?";
+  std::string sql = Select(kColumns, " FROM jobs WHERE owner = ?");
   if (before_seq > 0) sql += " AND seq < ?";
   // SQLite's lower() folds ASCII letters only; instr() compares bytes.
   if (!name_contains.empty()) sql += " AND instr(lower(name), lower(?)) > 0";
@@ -368,8 +377,7 @@ void JobStore::InsertCalibration(StoredCalibration* record) {
 
 std::optional<StoredCalibration> JobStore::GetCalibration(const std::string& id) const {
   std::lock_guard lock(mutex_);
-  Statement s(db_, std::string("SELECT ") + kCalibrationColumns +
-                       ", result FROM calibrations WHERE id = ?");
+  Statement s(db_, Select(kCalibrationColumns, ", result FROM calibrations WHERE id = ?"));
   s.Bind(1, id);
   if (!s.Step()) return std::nullopt;
   StoredCalibration record = ReadCalibration(s);
@@ -380,8 +388,7 @@ std::optional<StoredCalibration> JobStore::GetCalibration(const std::string& id)
 std::vector<StoredCalibration> JobStore::ListCalibrations(const std::string& owner,
                                                           int64_t before_seq,
                                                           uint32_t limit) const {
-  std::string sql =
-      std::string("SELECT ") + kCalibrationColumns + " FROM calibrations WHERE owner = ?";
+  std::string sql = Select(kCalibrationColumns, " FROM calibrations WHERE owner = ?");
   if (before_seq > 0) sql += " AND seq < ?";
   sql += " ORDER BY seq DESC LIMIT ?";
   std::lock_guard lock(mutex_);

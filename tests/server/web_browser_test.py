@@ -234,7 +234,7 @@ def main():
         runs = int(min(100000, max(50, 15.0 * rate / 60000)))
         print(f"probe: {rate:.3g} samples/s; the watched job gets {runs} runs")
         watched = client.submit(job("web_progress", runs, 600.0))
-        cancelled = client.submit(job("web_to_cancel", 100000, 600.0))
+        cancelled = client.submit(job("web_to_cancel", 30000, 600.0))  # 1.8e9 samples: minutes
         browser.get(base + "/jobs")
         wait_for(lambda: browser.js(
             "return document.querySelectorAll('tbody tr[data-state=RUNNING]').length") >= 1,
@@ -334,7 +334,7 @@ def main():
         browser.get(base + "/catalog")
         browser.screenshot(shot("9_catalog"))
         browser.click("a[href='/catalog/tactical']")
-        wait_for(lambda: "arw" in browser.source() or "white_noise" in browser.source(), 10,
+        wait_for(lambda: "Figures (datasheet units)" in browser.source(), 10,
                  "the preset's figures")
         browser.screenshot(shot("10_preset"))
 

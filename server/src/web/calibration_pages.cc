@@ -45,8 +45,18 @@ std::string PrintJson(const google::protobuf::Message& message) {
 
 std::string CalibrationFits(const v1::CalibrationResult& result) {
   std::string html;
-  for (const std::string& m : result.messages())
-    html += "<p class=\"note\">" + Escape(m) + "</p>\n";
+  if (result.messages_size() > 0) {
+    // The first message summarises the static detection; the pose list stays collapsed.
+    html += "<p class=\"note\">" + Escape(result.messages(0)) + "</p>\n";
+    if (result.messages_size() > 1) {
+      html += fmt::format("<details><summary>{} more messages (poses)</summary>\n",
+                          result.messages_size() - 1);
+      for (int i = 1; i < result.messages_size(); ++i) {
+        html += "<p class=\"note\">" + Escape(result.messages(i)) + "</p>\n";
+      }
+      html += "</details>\n";
+    }
+  }
   for (const v1::CalibrationFitResult& fit : result.fits()) {
     html += fmt::format(
         "<h3>{} fit</h3>\n<p>Residual RMS {} {} · {} poses or rows · {} iterations</p>\n"

@@ -125,6 +125,7 @@ class WebServer::Impl {
     http_ = std::make_unique<web::BoundedHttpServer>(limits, tls_.get(),
                                                      [this](httplib::Request& req) { Setup(req); });
     http_->set_payload_max_length(kMaxFormBytes);
+    http_->set_keep_alive_max_count(limits.max_requests_per_connection);
     http_->set_keep_alive_timeout(
         std::max<time_t>(1, static_cast<time_t>(options.keep_alive_timeout.count() / 1000)));
     http_->set_pre_routing_handler(
