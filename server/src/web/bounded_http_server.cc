@@ -404,6 +404,11 @@ void BoundedHttpServer::Leave(const std::string& address) {
   if (it != per_client_.end() && --it->second <= 0) per_client_.erase(it);
 }
 
+bool BoundedHttpServer::WidenBacklog() {
+  const socket_t sock = svr_sock_;
+  return sock != INVALID_SOCKET && ::listen(sock, SOMAXCONN) == 0;
+}
+
 bool BoundedHttpServer::process_and_close_socket(socket_t sock) {
   counters_.accepted.fetch_add(1);
   const int flags = fcntl(sock, F_GETFL, 0);

@@ -78,6 +78,14 @@ class BoundedHttpServer : public httplib::Server {
                     std::function<void(httplib::Request&)> setup);
   ~BoundedHttpServer() override;
 
+  // After bind_to_port / bind_to_any_port: widens the listening socket's backlog from the 5 that
+  // libcpp-httplib 0.11 is built with to SOMAXCONN (listen(2) on a listening socket sets its
+  // backlog anew). With 5, a burst of connections overflows the kernel's accept queue and each
+  // connection past it waits for SYN-ACK retransmissions (1 s, 3 s, 7 s, ...) before this server
+  // sees it; the accept thread drains the queue at once and refuses what the workers' queue
+  // cannot hold (503), so a wide backlog costs no worker. Returns false when listen(2) fails.
+  bool WidenBacklog();
+
   // Stops accepting, wakes every waiting connection; listen_after_bind() then returns once the
   // workers have finished their current request.
   void Stop();

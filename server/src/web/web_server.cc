@@ -12,7 +12,9 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <map>
 #include <thread>
 
@@ -159,6 +161,9 @@ class WebServer::Impl {
     if (port <= 0) {
       throw SpecError("--http-port", options.host + ":" + std::to_string(options.port),
                       "an address and port this host can listen on");
+    }
+    if (!http_->WidenBacklog()) {
+      spdlog::warn("web: the listening socket keeps its backlog of 5: {}", std::strerror(errno));
     }
     port_ = port;
     thread_ = std::thread([this] { http_->listen_after_bind(); });
@@ -408,7 +413,7 @@ class WebServer::Impl {
       if (!status.ok()) {
         return Html(res, 400, web::ErrorPage(viewer, 400, status.error_message()));
       }
-      if (s.size() == 1) return Html(res, 200, web::JobListPage(viewer, filter, list));
+      if (s.size() == 1) return Html(res, 200, web::JobListPage(viewer, filter, list, Grpc(req)));
       bool active = false;
       Html(res, 200, web::JobRows(list, &active));
       res.set_header("X-Driftlab-Active", active ? "1" : "0");
