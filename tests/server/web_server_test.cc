@@ -136,6 +136,7 @@ TEST_F(WebTest, SignedInOwnerGetsTheJobPagesTheReportAndTheResultFile) {
   EXPECT_EQ(list.status, 200);
   EXPECT_NE(list.body.find(id), std::string::npos);
   EXPECT_NE(list.body.find("SUCCEEDED"), std::string::npos);
+  EXPECT_NE(list.body.find("driftlab submit JOB.json --server " + address_), std::string::npos);
 
   const HttpResponse page = HttpRequest(port_, "GET", "/jobs/" + id, alice.Head());
   EXPECT_EQ(page.status, 200);
@@ -378,6 +379,11 @@ TEST_F(WebTest, SlowClientsBlockNeitherOtherClientsNorTheGrpcWatch) {
   EXPECT_GE(during, before / 3) << "Watch messages: " << before << " before, " << during
                                 << " during the HTTP abuse";
   EXPECT_LT(gap_during, 1.0) << "longest gap between Watch messages during the abuse";
+  // The figures, in the test's XML output (--gtest_output=xml), for the record of a run.
+  RecordProperty("watch_messages_2s_before", before);
+  RecordProperty("watch_messages_2s_during", during);
+  RecordProperty("watch_longest_gap_ms_before", static_cast<int>(gap_before * 1000));
+  RecordProperty("watch_longest_gap_ms_during", static_cast<int>(gap_during * 1000));
   v1::JobStatus status;
   EXPECT_TRUE(grpc.Cancel(id, &status).ok());
   EXPECT_EQ(HttpRequest(port_, "GET", "/signin").status, 200);

@@ -199,16 +199,15 @@ std::string JobRows(const v1::ListJobsResponse& jobs, bool* active) {
         s.cluster().empty() ? "–" : Escape(s.cluster()));
   }
   if (jobs.jobs().empty()) {
-    html = "<tr><td colspan=\"10\" class=\"empty\">No jobs" +
-           std::string(
-               " match. Submit one with <code>driftlab submit JOB.json --server …</code>"
-               "</td></tr>\n");
+    html =
+        "<tr><td colspan=\"10\" class=\"empty\">No jobs match (the commands below the table "
+        "submit one).</td></tr>\n";
   }
   return html;
 }
 
 std::string JobListPage(const Viewer& viewer, const JobFilter& filter,
-                        const v1::ListJobsResponse& jobs) {
+                        const v1::ListJobsResponse& jobs, const GrpcTarget& grpc) {
   bool active = false;
   const std::string rows = JobRows(jobs, &active);
   std::string body = "<h1>Jobs</h1>\n" + FilterForm(filter);
@@ -226,6 +225,14 @@ std::string JobListPage(const Viewer& viewer, const JobFilter& filter,
   body +=
       "<noscript><p class=\"note\">Without JavaScript the list does not refresh by itself: "
       "reload the page.</p></noscript>\n";
+  const std::string remote = " --server " + grpc.address + (grpc.tls ? " --tls-ca CA.pem" : "");
+  body +=
+      "<section class=\"commands\"><h2>From the command line</h2>\n"
+      "<p>With your token in the environment (<code>export DRIFTLAB_TOKEN=…</code>)" +
+      std::string(grpc.tls ? " and the certificate authority of the server in CA.pem" : "") +
+      ", submit a job file and list your jobs:</p>\n" +
+      Command("driftlab submit JOB.json" + remote) + Command("driftlab jobs" + remote) +
+      "</section>\n";
   return Page("Jobs", "jobs", viewer, body);
 }
 

@@ -27,9 +27,10 @@ struct JobFilter {
   std::string name;                  // substring of the name, ASCII case ignored
 };
 
-// The list page: filter form, the table of jobs (JobRows) and, when more exist, a note.
+// The list page: filter form, the table of jobs (JobRows), when more exist a note, and the
+// commands that submit and list jobs on this server.
 std::string JobListPage(const Viewer& viewer, const JobFilter& filter,
-                        const v1::ListJobsResponse& jobs);
+                        const v1::ListJobsResponse& jobs, const GrpcTarget& grpc);
 // The table rows of the list; *active is true when a listed job is QUEUED or RUNNING.
 std::string JobRows(const v1::ListJobsResponse& jobs, bool* active);
 
