@@ -16,6 +16,7 @@ build_packages=(
   libeigen3-dev libceres-dev libtbb-dev
   libprotobuf-dev protobuf-compiler libgrpc++-dev protobuf-compiler-grpc
   libyaml-cpp-dev libcli11-dev libfmt-dev libspdlog-dev libsqlite3-dev libssl-dev
+  libcpp-httplib-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libjs-dygraphs
 )

@@ -2,7 +2,8 @@
 """Soak test of driftlab-server on loopback with mixed valid and hostile requests.
 
     PYTHONPATH=<build>/python:clients/python /usr/bin/python3 bench/server_soak.py \\
-        --server-binary build/driftlab-server --minutes 30 [--clients 4] [--max-requests 200000]
+        --server-binary build/driftlab-server --minutes 30 [--clients 4] [--max-requests 200000] \\
+        [--http [--http-clients 2]]
 
 Starts driftlab-server itself on 127.0.0.1 (ephemeral port, --port-file, a tokens file with two
 owners, a temporary data directory), then runs --clients client threads for --minutes (or until
@@ -14,6 +15,15 @@ and YAML, too many checkpoints, a job over its memory limit, a wrong or malforme
 owner's job, garbage bytes as a protobuf request, a FitNoiseModel column name of 20 KB. Every 30 s
 it records the server's RSS, open file descriptors and database size (driftlab.db + WAL).
 
+With --http the server also serves its web pages (--http-port) and --http-clients more threads mix
+web traffic in, each from its own loopback address (127.0.0.10 + i): signed-in page views (job
+list and its polled rows, a job page, a report, a result download, the calibrations, the
+catalogue) and hostile requests that must each get one expected status — a wrong token (401, or
+429 once the address's tries are spent), another owner's job (404), a cancel without the form
+token (403), path traversal (404), 100 KB of headers and a 20 KB request line (400/414 or the
+connection closed), a connection that sends nothing (closed by the server within its 10 s request
+deadline). The web requests count in --max-requests.
+
 Pass (exit 0): the server never died, every request got its expected status, and the RSS and open
 files at the end are within the bounds printed (flat: RSS at most 1.5 x its value after the first
 minute plus 64 MiB; open files at most their value after the first minute plus 16). The database
@@ -21,7 +31,10 @@ grows only by the results of the valid jobs (printed as bytes per stored job).
 """
 
 import argparse
+import http.client
 import os
+import re
+import socket
 import pathlib
 import random
 import subprocess
@@ -80,6 +93,7 @@ class Soak:
         self.failures = []
         self.jobs_stored = 0
         self.stop = threading.Event()
+        self.finished = {0: [], 1: []}  # job ids of each owner that finished, for web traffic
 
     def call(self, kind, expected, function):
         try:
@@ -127,6 +141,8 @@ class Soak:
             mine.append(status.job_id)
             with self.lock:
                 self.jobs_stored += 1
+                self.finished[owner].append(status.job_id)
+                del self.finished[owner][:-10]
 
         def cancel_job():
             big = job()
@@ -197,6 +213,149 @@ class Soak:
         channel.close()
 
 
+class WebClient:
+    """Web traffic of one simulated browser from its own loopback address (--http)."""
+
+    def __init__(self, soak, port, index, token, other_token):
+        self.soak = soak
+        self.port = port
+        self.address = f"127.0.0.{10 + index}"
+        self.token = token
+        self.other_token = other_token
+        self.rng = random.Random(2000 + index)  # seeds fixed before the first run
+        self.cookie = None
+        self.csrf = None
+
+    def request(self, method, path, body=None, headers=None, cookie=True):
+        connection = http.client.HTTPConnection("127.0.0.1", self.port, timeout=60,
+                                                source_address=(self.address, 0))
+        all_headers = dict(headers or {})
+        if cookie and self.cookie:
+            all_headers["Cookie"] = self.cookie
+        if body is not None:
+            all_headers["Content-Type"] = "application/x-www-form-urlencoded"
+        try:
+            connection.request(method, path, body, all_headers)
+            response = connection.getresponse()
+            data = response.read()
+            return response.status, response.getheader("Set-Cookie"), data
+        finally:
+            connection.close()
+
+    def sign_in(self):
+        status, set_cookie, _ = self.request("POST", "/signin", f"token={self.token}",
+                                             cookie=False)
+        if status != 303 or not set_cookie:
+            raise RuntimeError(f"sign-in answered {status}")
+        self.cookie = set_cookie.split(";")[0]
+        _, _, page = self.request("GET", "/jobs")
+        match = re.search(rb'name="csrf" value="([0-9a-f]{64})"', page)
+        self.csrf = match.group(1).decode() if match else ""
+
+    def raw(self, data, wait_s=15.0):
+        """Sends data on a new connection; the status the server answers (0: closed without an
+        answer) once it has closed the connection (bounded by wait_s)."""
+        with socket.create_connection(("127.0.0.1", self.port), timeout=wait_s,
+                                      source_address=(self.address, 0)) as sock:
+            try:
+                sock.sendall(data)
+            except OSError:
+                pass
+            received = b""
+            deadline = time.monotonic() + wait_s
+            while time.monotonic() < deadline:
+                try:
+                    chunk = sock.recv(65536)
+                except OSError:
+                    break
+                if not chunk:
+                    break
+                received += chunk
+            match = re.match(rb"HTTP/1\.1 (\d{3})", received)
+            return int(match.group(1)) if match else 0
+
+    def run(self, own_jobs, other_jobs):
+        self.sign_in()
+        soak = self.soak
+
+        def get(path, expected):
+            def action():
+                status, _, _ = self.request("GET", path())
+                if status not in expected:
+                    raise AssertionError(f"GET {path()} answered {status}")
+            return action
+
+        def own():
+            return own_jobs[-1] if own_jobs else "job-" + "0" * 24
+
+        def wrong_token():
+            status, _, _ = self.request("POST", "/signin", "token=wrong-" + str(self.rng.random()),
+                                        cookie=False)
+            if status not in (401, 429):
+                raise AssertionError(f"wrong token answered {status}")
+
+        def other_owner():
+            if other_jobs:
+                for suffix in ("", "/report.html", "/result.json", "/job.json", "/status"):
+                    status, _, _ = self.request("GET", f"/jobs/{other_jobs[-1]}{suffix}")
+                    if status != 404:
+                        raise AssertionError(f"another owner's job{suffix} answered {status}")
+
+        def cancel_without_token():
+            status, _, _ = self.request("POST", f"/jobs/{own()}/cancel", "csrf=")
+            if status != 403:
+                raise AssertionError(f"cancel without the form token answered {status}")
+
+        def huge_headers():
+            head = b"GET /jobs HTTP/1.1\r\nHost: x\r\n" + b"".join(
+                b"X-Filler-%d: %s\r\n" % (i, b"a" * 90) for i in range(1000)) + b"\r\n"
+            if self.raw(head) not in (0, 400):
+                raise AssertionError("100 KB of headers were not refused")
+            if self.raw(b"GET /" + b"p" * 20000 + b" HTTP/1.1\r\nHost: x\r\n\r\n") not in (0, 414):
+                raise AssertionError("a 20 KB request line was not refused")
+
+        def silent():
+            started = time.monotonic()
+            self.raw(b"", wait_s=20.0)
+            if time.monotonic() - started > 15.0:
+                raise AssertionError("a silent connection was kept past the request deadline")
+
+        cases = [
+            ("web: job list", get(lambda: "/jobs", (200,)), 4),
+            ("web: polled rows", get(lambda: "/jobs/rows", (200,)), 8),
+            ("web: job page", get(lambda: f"/jobs/{own()}", (200, 404)), 4),
+            ("web: report", get(lambda: f"/jobs/{own()}/report.html", (200, 404, 409)), 1),
+            ("web: result download", get(lambda: f"/jobs/{own()}/result.json", (200, 404, 409)), 1),
+            ("web: calibrations", get(lambda: "/calibrations", (200,)), 1),
+            ("web: catalogue", get(lambda: "/catalog/tactical", (200,)), 1),
+            ("web: path traversal", get(lambda: "/static/..%2f..%2f..%2fetc%2fpasswd", (404,)), 1),
+            ("web: wrong token", wrong_token, 1),
+            ("web: another owner's job", other_owner, 1),
+            ("web: cancel without form token", cancel_without_token, 1),
+            ("web: huge headers", huge_headers, 1),
+            ("web: silent connection", silent, 0.2),
+        ]
+        weights = [case[2] for case in cases]
+        next_at = time.monotonic()
+        while not soak.stop.is_set():
+            kind, action, _ = self.rng.choices(cases, weights)[0]
+            try:
+                action()
+                failure = None
+            except Exception as error:  # every unexpected answer is a failure of the soak
+                failure = f"{kind}: {error}"
+            with soak.lock:
+                soak.requests += 1
+                soak.counts[kind] = soak.counts.get(kind, 0) + 1
+                if soak.requests >= soak.args.max_requests:
+                    soak.stop.set()
+                if failure:
+                    soak.failures.append(failure[:300])
+            if soak.args.rate > 0:
+                next_at += 1.0 / soak.args.rate
+                soak.stop.wait(timeout=max(0.0, next_at - time.monotonic()))
+
+
 def sample(pid, data_dir):
     rss_kib = 0
     with open(f"/proc/{pid}/status") as status:
@@ -216,6 +375,9 @@ def main():
     parser.add_argument("--max-requests", type=int, default=200000)
     parser.add_argument("--rate", type=float, default=10.0,
                         help="requests per second per client (0: unpaced)")
+    parser.add_argument("--http", action="store_true",
+                        help="serve the web pages and mix web traffic in")
+    parser.add_argument("--http-clients", type=int, default=2)
     args = parser.parse_args()
 
     with tempfile.TemporaryDirectory(prefix="driftlab_soak_") as tmp:
@@ -229,11 +391,13 @@ def main():
         (tmp / "tokens.txt").write_text("\n".join(lines) + "\n")
         data = tmp / "data"
         port_file = tmp / "port"
+        http_port_file = tmp / "http-port"
         log = open(tmp / "server.log", "w")
+        web = ["--http-port", "0", "--http-port-file", str(http_port_file)] if args.http else []
         server = subprocess.Popen(
             [args.server_binary, "--listen", "127.0.0.1:0", "--data", str(data), "--tokens",
-             str(tmp / "tokens.txt"), "--port-file", str(port_file), "--max-queued-jobs", "1000"],
-            stdout=log, stderr=subprocess.STDOUT)
+             str(tmp / "tokens.txt"), "--port-file", str(port_file), "--max-queued-jobs", "1000"]
+            + web, stdout=log, stderr=subprocess.STDOUT)
         for _ in range(300):  # bounded wait for the port file (100 ms steps: 30 s)
             if port_file.exists() or server.poll() is not None:
                 break
@@ -243,6 +407,14 @@ def main():
         soak = Soak(args, int(port_file.read_text()), tokens)
         start = sample(server.pid, data)
         threads = [threading.Thread(target=soak.client, args=(i,)) for i in range(args.clients)]
+        if args.http:
+            http_port = int(http_port_file.read_text())
+            for i in range(args.http_clients):
+                owner = i % 2
+                web_client = WebClient(soak, http_port, i, tokens[owner], tokens[1 - owner])
+                threads.append(threading.Thread(
+                    target=web_client.run,
+                    args=(soak.finished[owner], soak.finished[1 - owner])))
         t0 = time.monotonic()
         for thread in threads:
             thread.start()
@@ -270,7 +442,7 @@ def main():
         rss_bound = 1.5 * after_warmup[1] + 64 * 1024
         fd_bound = after_warmup[2] + 16
         print(f"requests: {soak.requests} in {time.monotonic() - t0:.0f} s from {args.clients} "
-              "clients")
+              f"gRPC clients" + (f" and {args.http_clients} web clients" if args.http else ""))
         for kind, count in sorted(soak.counts.items()):
             print(f"  {kind:28s} {count:7d}")
         print(f"RSS: start {start[0] / 1024:.1f} MiB, after 1 min {after_warmup[1] / 1024:.1f} MiB,"

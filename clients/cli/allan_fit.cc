@@ -81,12 +81,11 @@ int RunAllanFit(const AllanFitOptions& options) {
   }
   fmt::print("fit time {:.3f} s\n", fit.fit_time_s());
   if (!options.fit_json_path.empty()) {
-    google::protobuf::util::JsonPrintOptions print;
-    print.add_whitespace = true;
-    print.preserve_proto_field_names = true;
     std::string json;
-    if (!google::protobuf::util::MessageToJsonString(fit, &json, print).ok()) {
-      fmt::print(stderr, "error: cannot convert the fit to JSON\n");
+    try {
+      json = app::NoiseModelFitToJson(fit);
+    } catch (const SpecError& e) {
+      fmt::print(stderr, "error: {}\n", e.what());
       return kExitFailure;
     }
     if (const int status = WriteOutputText(options.fit_json_path, json, "--fit-json")) {

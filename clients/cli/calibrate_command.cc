@@ -66,12 +66,10 @@ int RunCalibrate(CalibrateOptions o) {
   for (const std::string& m : result.messages()) fmt::print("{}\n", m);
   for (const v1::CalibrationFitResult& fit : result.fits()) PrintFit(fit);
   std::string json;
-  google::protobuf::util::JsonPrintOptions print;
-  print.add_whitespace = true;
-  print.preserve_proto_field_names = true;
-  print.always_print_primitive_fields = true;
-  if (!google::protobuf::util::MessageToJsonString(result, &json, print).ok()) {
-    fmt::print(stderr, "error: cannot convert the result to JSON\n");
+  try {
+    json = app::CalibrationResultToJson(result);
+  } catch (const SpecError& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
     return kExitFailure;
   }
   if (const int status = WriteOutputText(o.out_path, json, "--out")) return status;

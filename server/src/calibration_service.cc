@@ -11,8 +11,11 @@
 // field ("settings.rate_hz"): a library error about a settings field is reported with the
 // "settings." prefix, so the path is the request's proto path.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <climits>
 #include <cmath>
 #include <string>
@@ -23,6 +26,7 @@
 #include "driftlab/app/sensor_model_json.h"
 #include "driftlab/calib/datasheet.h"
 #include "driftlab/server/data_services.h"
+#include "driftlab/server/job_manager.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::server {
@@ -181,16 +185,50 @@ app::NoiseFitSettings ToNoiseFitSettings(const v1::NoiseFitSettings& in) {
   return out;
 }
 
+double UnixNow() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+// The stored name of a call: bounded, as it is the caller's text.
+constexpr size_t kMaxRecordNameBytes = 256;
+
+// Records a call that returned a result (data_services.h); logs instead of failing the call.
+void Record(JobStore* store, const std::string& owner, const std::string& kind, std::string name,
+            const google::protobuf::Message& settings, const google::protobuf::Message& result,
+            uint64_t rows, std::chrono::steady_clock::time_point started) {
+  if (store == nullptr) return;
+  StoredCalibration record;
+  try {
+    record.id = NewStoreId("cal-");
+    record.owner = owner;
+    record.kind = kind;
+    if (name.size() > kMaxRecordNameBytes) name.resize(kMaxRecordNameBytes);
+    record.name = std::move(name);
+    record.settings = SerializeDeterministic(settings);
+    record.result = SerializeDeterministic(result);
+    record.rows = rows;
+    record.created_unix_s = UnixNow();
+    record.elapsed_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    store->InsertCalibration(&record);
+    spdlog::info("calibration={} owner={} kind={} rows={}", record.id, owner, kind, rows);
+  } catch (const std::exception& e) {
+    spdlog::warn("calibration of owner={} not recorded: {}", owner,
+                 MessageText(e.what(), kMaxMessageTextBytes));
+  }
+}
+
 class CalibrationService final : public v1::Calibration::Service {
  public:
-  CalibrationService(const Authenticator* auth, const ServerLimits& limits)
-      : auth_(auth), limits_(limits) {}
+  CalibrationService(const Authenticator* auth, const ServerLimits& limits, JobStore* store)
+      : auth_(auth), limits_(limits), store_(store) {}
 
   grpc::Status Calibrate(grpc::ServerContext* context,
                          grpc::ServerReader<v1::CalibrateRequest>* reader,
                          v1::CalibrationResult* response) override {
     std::string owner;
     if (grpc::Status s = auth_->Authenticate(*context, &owner); !s.ok()) return s;
+    const auto started = std::chrono::steady_clock::now();
     v1::CalibrateSettings settings;
     app::NumericTable table;
     try {
@@ -202,6 +240,8 @@ class CalibrationService final : public v1::Calibration::Service {
     } catch (const SpecError& e) {
       return SettingsError(e, v1::CalibrateSettings::descriptor());
     }
+    Record(store_, owner, "calibrate", settings.data_name(), settings, *response, table.rows(),
+           started);
     return grpc::Status::OK;
   }
 
@@ -210,6 +250,7 @@ class CalibrationService final : public v1::Calibration::Service {
                              v1::NoiseModelFit* response) override {
     std::string owner;
     if (grpc::Status s = auth_->Authenticate(*context, &owner); !s.ok()) return s;
+    const auto started = std::chrono::steady_clock::now();
     v1::NoiseFitSettings settings;
     app::NumericTable table;
     try {
@@ -221,6 +262,8 @@ class CalibrationService final : public v1::Calibration::Service {
     } catch (const SpecError& e) {
       return SettingsError(e, v1::NoiseFitSettings::descriptor());
     }
+    Record(store_, owner, "noise_fit", fmt::format("{}", fmt::join(settings.columns(), ", ")),
+           settings, *response, table.rows(), started);
     return grpc::Status::OK;
   }
 
@@ -251,13 +294,15 @@ class CalibrationService final : public v1::Calibration::Service {
  private:
   const Authenticator* auth_;
   const ServerLimits limits_;
+  JobStore* store_;
 };
 
 }  // namespace
 
 std::unique_ptr<v1::Calibration::Service> MakeCalibrationService(const Authenticator* auth,
-                                                                 const ServerLimits& limits) {
-  return std::make_unique<CalibrationService>(auth, limits);
+                                                                 const ServerLimits& limits,
+                                                                 JobStore* store) {
+  return std::make_unique<CalibrationService>(auth, limits, store);
 }
 
 }  // namespace driftlab::server

@@ -148,7 +148,9 @@ class CatalogService final : public v1::Catalog::Service {
                            v1::ListPresetsResponse* response) override {
     std::string owner;
     if (grpc::Status s = auth_->Authenticate(*context, &owner); !s.ok()) return s;
-    for (const ImuErrorModel& model : ImuCatalogue()) FillSummary(model, response->add_presets());
+    for (v1::PresetSummary& summary : PresetSummaries()) {
+      *response->add_presets() = std::move(summary);
+    }
     return grpc::Status::OK;
   }
 
@@ -156,18 +158,15 @@ class CatalogService final : public v1::Catalog::Service {
                          v1::Preset* response) override {
     std::string owner;
     if (grpc::Status s = auth_->Authenticate(*context, &owner); !s.ok()) return s;
-    const std::vector<ImuErrorModel>& catalogue = ImuCatalogue();
-    const auto it = std::find_if(catalogue.begin(), catalogue.end(),
-                                 [&](const ImuErrorModel& m) { return m.name == request->name(); });
-    if (it == catalogue.end()) {
+    std::optional<v1::Preset> preset = FindPreset(request->name());
+    if (!preset) {
       std::vector<std::string> names;
-      for (const ImuErrorModel& m : catalogue) names.push_back(m.name);
+      for (const ImuErrorModel& m : ImuCatalogue()) names.push_back(m.name);
       return grpc::Status(grpc::StatusCode::NOT_FOUND,
                           fmt::format("name: unknown preset \"{}\"; presets: {}", request->name(),
                                       fmt::join(names, ", ")));
     }
-    FillSummary(*it, response->mutable_summary());
-    *response->mutable_sensor() = app::ToSensorModelProto(*it);
+    *response = std::move(*preset);
     return grpc::Status::OK;
   }
 
@@ -185,6 +184,23 @@ class CatalogService final : public v1::Catalog::Service {
 };
 
 }  // namespace
+
+std::vector<v1::PresetSummary> PresetSummaries() {
+  std::vector<v1::PresetSummary> summaries;
+  for (const ImuErrorModel& model : ImuCatalogue()) FillSummary(model, &summaries.emplace_back());
+  return summaries;
+}
+
+std::optional<v1::Preset> FindPreset(const std::string& name) {
+  const std::vector<ImuErrorModel>& catalogue = ImuCatalogue();
+  const auto it = std::find_if(catalogue.begin(), catalogue.end(),
+                               [&](const ImuErrorModel& m) { return m.name == name; });
+  if (it == catalogue.end()) return std::nullopt;
+  v1::Preset preset;
+  FillSummary(*it, preset.mutable_summary());
+  *preset.mutable_sensor() = app::ToSensorModelProto(*it);
+  return preset;
+}
 
 std::unique_ptr<v1::Catalog::Service> MakeCatalogService(const Authenticator* auth,
                                                          std::filesystem::path examples_dir) {

@@ -2,7 +2,6 @@
 
 #include <google/protobuf/io/coded_stream.h>
 #include <google/protobuf/io/zero_copy_stream_impl_lite.h>
-#include <openssl/rand.h>
 #include <spdlog/spdlog.h>
 #include <tbb/info.h>
 
@@ -27,24 +26,13 @@ using SteadyClock = std::chrono::steady_clock;
 constexpr double kMaxDeadline_s = 365.0 * 86400.0;
 constexpr uint32_t kDefaultPageSize = 100;
 constexpr uint32_t kMaxPageSize = 1000;
+constexpr size_t kMaxNameFilterBytes = 256;
 // Cancel waits this long for the worker to stop; the engine stops within 1024 samples per worker
 // (milliseconds), so reaching it means a stuck worker, reported as an error.
 constexpr std::chrono::seconds kCancelWait{10};
 
 double UnixNow() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
-
-std::string NewJobId() {
-  unsigned char bytes[12];
-  if (RAND_bytes(bytes, sizeof(bytes)) != 1) throw std::runtime_error("RAND_bytes failed");
-  static constexpr char kHex[] = "0123456789abcdef";
-  std::string id = "job-";
-  for (unsigned char b : bytes) {
-    id.push_back(kHex[b >> 4]);
-    id.push_back(kHex[b & 15]);
-  }
-  return id;
 }
 
 std::string FieldPath(const std::string& path, const FieldDescriptor& field, int index) {
@@ -220,6 +208,7 @@ void FillStatus(const StoredJob& row, v1::JobStatus* status) {
   if (row.started_unix_s) status->set_started_unix_s(*row.started_unix_s);
   if (row.finished_unix_s) status->set_finished_unix_s(*row.finished_unix_s);
   status->set_attempts(row.attempts);
+  status->set_cluster(row.cluster);
   if (row.state == v1::SUCCEEDED) {
     status->set_runs_done(row.runs_total);
     status->set_samples_done(row.samples_total);
@@ -325,7 +314,7 @@ grpc::Status JobManager::Submit(const std::string& owner, const v1::SubmitJobReq
   }
   auto live = std::make_shared<LiveJob>();
   StoredJob& row = live->row;
-  row.id = NewJobId();
+  row.id = NewStoreId("job-");
   row.owner = owner;
   row.request = SerializeDeterministic(request);
   row.name = request.job().name();
@@ -478,7 +467,13 @@ grpc::Status JobManager::List(const std::string& owner, const v1::ListJobsReques
           SpecError("page_token", "\"" + token + "\"", "the next_page_token of the previous page"));
     }
   }
-  const std::vector<StoredJob> rows = store_->List(owner, states, before_seq, page_size + 1);
+  if (request.name_contains().size() > kMaxNameFilterBytes) {
+    return InvalidArgument(SpecError("name_contains",
+                                     std::to_string(request.name_contains().size()) + " bytes",
+                                     "at most " + std::to_string(kMaxNameFilterBytes) + " bytes"));
+  }
+  const std::vector<StoredJob> rows =
+      store_->List(owner, states, before_seq, page_size + 1, request.name_contains());
   std::lock_guard lock(mutex_);
   for (size_t i = 0; i < rows.size() && i < page_size; ++i) {
     const auto it = live_.find(rows[i].id);
@@ -619,6 +614,14 @@ uint32_t JobManager::MarkRunning(const std::shared_ptr<LiveJob>& live) {
   return attempts;
 }
 
+void JobManager::SetCluster(const std::shared_ptr<LiveJob>& live, const std::string& handle) {
+  store_->SetCluster(live->row.id, handle);
+  std::lock_guard lock(mutex_);
+  live->row.cluster = handle;
+  ++live->version;
+  changed_.notify_all();
+}
+
 void JobManager::RunClusterJob(const std::shared_ptr<LiveJob>& live) {
   // How often the cluster is asked for the shards' state (one squeue / kubectl get).
   constexpr auto kClusterPoll = std::chrono::milliseconds(500);
@@ -649,7 +652,7 @@ void JobManager::RunClusterJob(const std::shared_ptr<LiveJob>& live) {
           id, live->row.owner, runs, attempts, run->Handle(), k);
     }
     std::string handle = run->Handle();
-    store_->SetCluster(id, handle);
+    SetCluster(live, handle);
     std::string last_text, last_warning;
     for (;;) {
       CancelReason reason = CancelReason::kNone;
@@ -673,7 +676,7 @@ void JobManager::RunClusterJob(const std::shared_ptr<LiveJob>& live) {
       for (const std::string& note : notes) spdlog::info("job={} {}", id, note);
       if (run->Handle() != handle) {
         handle = run->Handle();
-        store_->SetCluster(id, handle);
+        SetCluster(live, handle);
       }
       if (!progress) {
         if (warning != last_warning) spdlog::warn("job={} {}", id, warning);

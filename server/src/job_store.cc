@@ -1,5 +1,6 @@
 #include "driftlab/server/job_store.h"
 
+#include <openssl/rand.h>
 #include <sqlite3.h>
 
 #include <stdexcept>
@@ -33,11 +34,37 @@ CREATE TRIGGER IF NOT EXISTS jobs_result_immutable BEFORE UPDATE OF result ON jo
 CREATE TRIGGER IF NOT EXISTS jobs_result_kept BEFORE DELETE ON jobs
   WHEN OLD.result IS NOT NULL
   BEGIN SELECT RAISE(ABORT, 'a stored result is never deleted'); END;
+CREATE TABLE IF NOT EXISTS calibrations (
+  seq INTEGER PRIMARY KEY AUTOINCREMENT,
+  id TEXT NOT NULL UNIQUE,
+  owner TEXT NOT NULL,
+  kind TEXT NOT NULL,
+  name TEXT NOT NULL,
+  settings BLOB NOT NULL,
+  result BLOB NOT NULL,
+  rows INTEGER NOT NULL,
+  created_unix_s REAL NOT NULL,
+  elapsed_s REAL NOT NULL
+);
+CREATE INDEX IF NOT EXISTS calibrations_owner_seq ON calibrations (owner, seq);
+CREATE TRIGGER IF NOT EXISTS calibrations_immutable BEFORE UPDATE ON calibrations
+  BEGIN SELECT RAISE(ABORT, 'a stored calibration is never changed'); END;
+CREATE TRIGGER IF NOT EXISTS calibrations_kept BEFORE DELETE ON calibrations
+  BEGIN SELECT RAISE(ABORT, 'a stored calibration is never deleted'); END;
 )sql";
 
 constexpr const char* kColumns =
     "seq, id, owner, state, request, name, runs_total, samples_total, error, submitted_unix_s, "
     "started_unix_s, finished_unix_s, deadline_unix_s, attempts, result IS NOT NULL, cluster";
+
+// "SELECT <columns><rest>", built by appending (GCC 12 warns falsely, -Warray-bounds, about
+// std::string("...") + const char* + "..." chains inlined here).
+std::string Select(const char* columns, const char* rest) {
+  std::string sql = "SELECT ";
+  sql.append(columns);
+  sql.append(rest);
+  return sql;
+}
 
 // A prepared statement, finalized on scope exit.
 class Statement {
@@ -122,7 +149,36 @@ StoredJob ReadRow(const Statement& s) {
   return job;
 }
 
+constexpr const char* kCalibrationColumns =
+    "seq, id, owner, kind, name, settings, rows, created_unix_s, elapsed_s";
+
+StoredCalibration ReadCalibration(const Statement& s) {
+  StoredCalibration record;
+  record.seq = s.Int(0);
+  record.id = s.Bytes(1);
+  record.owner = s.Bytes(2);
+  record.kind = s.Bytes(3);
+  record.name = s.Bytes(4);
+  record.settings = s.Bytes(5);
+  record.rows = static_cast<uint64_t>(s.Int(6));
+  record.created_unix_s = s.Real(7);
+  record.elapsed_s = s.Real(8);
+  return record;
+}
+
 }  // namespace
+
+std::string NewStoreId(std::string_view prefix) {
+  unsigned char bytes[12];
+  if (RAND_bytes(bytes, sizeof(bytes)) != 1) throw std::runtime_error("RAND_bytes failed");
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string id(prefix);
+  for (unsigned char b : bytes) {
+    id.push_back(kHex[b >> 4]);
+    id.push_back(kHex[b & 15]);
+  }
+  return id;
+}
 
 JobStore::JobStore(const std::filesystem::path& data_dir) {
   std::filesystem::create_directories(data_dir);
@@ -180,7 +236,7 @@ void JobStore::Insert(StoredJob* job) {
 
 std::optional<StoredJob> JobStore::Get(const std::string& id) const {
   std::lock_guard lock(mutex_);
-  Statement s(db_, std::string("SELECT ") + kColumns + " FROM jobs WHERE id = ?");
+  Statement s(db_, Select(kColumns, " FROM jobs WHERE id = ?"));
   s.Bind(1, id);
   if (!s.Step()) return std::nullopt;
   return ReadRow(s);
@@ -245,7 +301,7 @@ std::vector<StoredJob> JobStore::RecoverQueued() {
     s.Bind(1, int64_t{v1::QUEUED}).Bind(2, int64_t{v1::RUNNING});
     s.Step();
   }
-  Statement s(db_, std::string("SELECT ") + kColumns + " FROM jobs WHERE state = ? ORDER BY seq");
+  Statement s(db_, Select(kColumns, " FROM jobs WHERE state = ? ORDER BY seq"));
   s.Bind(1, int64_t{v1::QUEUED});
   std::vector<StoredJob> jobs;
   while (s.Step()) jobs.push_back(ReadRow(s));
@@ -269,9 +325,11 @@ std::optional<std::string> JobStore::GetResult(const std::string& id) const {
 
 std::vector<StoredJob> JobStore::List(const std::string& owner,
                                       const std::vector<v1::JobState>& states, int64_t before_seq,
-                                      uint32_t limit) const {
-  std::string sql = std::string("SELECT ") + kColumns + " FROM jobs WHERE owner = ?";
+                                      uint32_t limit, const std::string& name_contains) const {
+  std::string sql = Select(kColumns, " FROM jobs WHERE owner = ?");
   if (before_seq > 0) sql += " AND seq < ?";
+  // SQLite's lower() folds ASCII letters only; instr() compares bytes.
+  if (!name_contains.empty()) sql += " AND instr(lower(name), lower(?)) > 0";
   if (!states.empty()) {
     sql += " AND state IN (";
     for (size_t i = 0; i < states.size(); ++i) sql += i ? ", ?" : "?";
@@ -283,6 +341,7 @@ std::vector<StoredJob> JobStore::List(const std::string& owner,
   int i = 1;
   s.Bind(i++, owner);
   if (before_seq > 0) s.Bind(i++, before_seq);
+  if (!name_contains.empty()) s.Bind(i++, name_contains);
   for (v1::JobState state : states) s.Bind(i++, int64_t{state});
   s.Bind(i, int64_t{limit});
   std::vector<StoredJob> jobs;
@@ -296,6 +355,51 @@ std::map<v1::JobState, uint32_t> JobStore::CountByState() const {
   std::map<v1::JobState, uint32_t> counts;
   while (s.Step()) counts[static_cast<v1::JobState>(s.Int(0))] = static_cast<uint32_t>(s.Int(1));
   return counts;
+}
+
+void JobStore::InsertCalibration(StoredCalibration* record) {
+  std::lock_guard lock(mutex_);
+  Statement s(db_,
+              "INSERT INTO calibrations (id, owner, kind, name, settings, result, rows, "
+              "created_unix_s, elapsed_s) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
+  s.Bind(1, record->id)
+      .Bind(2, record->owner)
+      .Bind(3, record->kind)
+      .Bind(4, record->name)
+      .BindBlob(5, record->settings)
+      .BindBlob(6, record->result)
+      .Bind(7, static_cast<int64_t>(record->rows))
+      .Bind(8, record->created_unix_s)
+      .Bind(9, record->elapsed_s);
+  s.Step();
+  record->seq = sqlite3_last_insert_rowid(db_);
+}
+
+std::optional<StoredCalibration> JobStore::GetCalibration(const std::string& id) const {
+  std::lock_guard lock(mutex_);
+  Statement s(db_, Select(kCalibrationColumns, ", result FROM calibrations WHERE id = ?"));
+  s.Bind(1, id);
+  if (!s.Step()) return std::nullopt;
+  StoredCalibration record = ReadCalibration(s);
+  record.result = s.Bytes(9);
+  return record;
+}
+
+std::vector<StoredCalibration> JobStore::ListCalibrations(const std::string& owner,
+                                                          int64_t before_seq,
+                                                          uint32_t limit) const {
+  std::string sql = Select(kCalibrationColumns, " FROM calibrations WHERE owner = ?");
+  if (before_seq > 0) sql += " AND seq < ?";
+  sql += " ORDER BY seq DESC LIMIT ?";
+  std::lock_guard lock(mutex_);
+  Statement s(db_, sql);
+  int i = 1;
+  s.Bind(i++, owner);
+  if (before_seq > 0) s.Bind(i++, before_seq);
+  s.Bind(i, int64_t{limit});
+  std::vector<StoredCalibration> records;
+  while (s.Step()) records.push_back(ReadCalibration(s));
+  return records;
 }
 
 }  // namespace driftlab::server

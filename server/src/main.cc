@@ -3,14 +3,18 @@
 //   driftlab-server --listen ADDR --data DIR [--tls-cert F --tls-key F] [--tokens FILE]
 //       [--max-concurrent-jobs N] [--max-queued-jobs N] [--max-job-samples N]
 //       [--threads-per-job N] [--examples DIR] [--port-file F] [--shutdown-grace-s S]
+//       [--http-port P [--http-host ADDR] [--http-port-file F]]
 //       [--cluster slurm|k8s --cluster-dir DIR [--cluster-threshold-samples N] [--cluster-shards K]
 //        [--slurm-partition P] [--cluster-driftlab PATH]
 //        [--k8s-template F] [--k8s-image I] [--k8s-namespace NS] [--k8s-claim C]]
 //   driftlab-server hash-token TOKEN      prints the SHA-256 to put in a tokens file
 //
 // The first line on stdout is "listening on HOST:PORT" (with the bound port when ADDR ends in
-// :0); --port-file also writes the port (atomically: written to F.tmp, then renamed). Logs go to
-// stderr, one line per job transition. SIGTERM / SIGINT: graceful shutdown (server.h).
+// :0); --port-file also writes the port (atomically: written to F.tmp, then renamed). With
+// --http-port the web pages (web_server.h, docs/web.md) listen on --http-host (127.0.0.1) at that
+// port (0 = any), the second line is "web pages on http[s]://HOST:PORT" and --http-port-file
+// gets that port. Logs go to stderr, one line per job transition. SIGTERM / SIGINT: graceful
+// shutdown (server.h).
 #include <fmt/format.h>
 #include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>
@@ -118,6 +122,16 @@ int main(int argc, char** argv) {
   app.add_option("--k8s-claim", options.cluster.k8s_claim,
                  "ReadWriteMany claim mounted at --cluster-dir in the shard pods")
       ->capture_default_str();
+  std::optional<int> http_port;
+  std::optional<std::string> http_port_file;
+  app.add_option("--http-port", http_port,
+                 "Serve the web pages (jobs, reports, calibrations, IMU catalogue) on this port "
+                 "(0 = any; default: no web pages)")
+      ->check(CLI::Range(0, 65535));
+  app.add_option("--http-host", options.web.host,
+                 "Address of the web pages (TLS with --tls-cert/--tls-key as gRPC)")
+      ->capture_default_str();
+  app.add_option("--http-port-file", http_port_file, "Write the web pages' port to this file");
   std::string token;
   CLI::App* hash = app.add_subcommand("hash-token", "Print the SHA-256 of TOKEN for a tokens file");
   hash->add_option("token", token, "The bearer token")->required();
@@ -183,12 +197,22 @@ int main(int argc, char** argv) {
   if (tls_key) options.tls_key = *tls_key;
   if (tokens) options.tokens_file = *tokens;
   options.shutdown_grace = std::chrono::milliseconds(static_cast<int64_t>(grace_s * 1000));
+  if (http_port) options.web.port = *http_port;
+  if (http_port_file && !http_port) {
+    fmt::print(stderr, "error: --http-port-file needs --http-port\n");
+    return 2;
+  }
 
   std::unique_ptr<driftlab::server::Server> server;
   try {
     server = std::make_unique<driftlab::server::Server>(options);
     fmt::print("listening on {}\n", BoundAddress(options.listen, server->port()));
+    if (server->http_port() > 0) {
+      fmt::print("web pages on {}://{}:{}\n", tls_cert ? "https" : "http", options.web.host,
+                 server->http_port());
+    }
     std::fflush(stdout);
+    if (http_port_file) WritePortFile(*http_port_file, server->http_port());
     if (port_file) WritePortFile(*port_file, server->port());
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());

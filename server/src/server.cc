@@ -131,7 +131,7 @@ Server::Server(const ServerOptions& options) : options_(options) {
 
   services_.push_back(MakeJobsService(&auth_, manager_.get()));
   services_.push_back(MakeCatalogService(&auth_, options.examples_dir));
-  services_.push_back(MakeCalibrationService(&auth_, options.limits));
+  services_.push_back(MakeCalibrationService(&auth_, options.limits, store_.get()));
   services_.push_back(MakeDatasetsService(&auth_, options.limits));
   for (const auto& service : services_) builder.RegisterService(service.get());
   std::vector<std::unique_ptr<grpc::experimental::ServerInterceptorFactoryInterface>> interceptors;
@@ -144,6 +144,25 @@ Server::Server(const ServerOptions& options) : options_(options) {
     manager_->Shutdown(std::chrono::milliseconds(0));
     throw SpecError("--listen", options.listen, "an address this host can listen on (host:port)");
   }
+  if (options.web.port >= 0) {
+    WebOptions web = options.web;
+    web.tls_cert = options.tls_cert;
+    web.tls_key = options.tls_key;
+    WebContext context;
+    context.auth = &auth_;
+    context.jobs = manager_.get();
+    context.store = store_.get();
+    context.grpc_listen = options.listen;
+    context.grpc_port = port_;
+    context.grpc_tls = options.tls_cert.has_value();
+    try {
+      web_ = std::make_unique<WebServer>(web, context);
+    } catch (...) {
+      server_->Shutdown();
+      manager_->Shutdown(std::chrono::milliseconds(0));
+      throw;
+    }
+  }
   spdlog::info("listening on {} (port {}, {}, {} worker(s) x {} thread(s), data {})",
                options.listen, port_, options.tls_cert ? "TLS" : "insecure",
                options.limits.max_concurrent_jobs, manager_->threads_per_job(),
@@ -151,6 +170,8 @@ Server::Server(const ServerOptions& options) : options_(options) {
 }
 
 Server::~Server() { Shutdown(); }
+
+int Server::http_port() const { return web_ ? web_->port() : -1; }
 
 void Server::Shutdown() {
   if (shut_down_) return;
@@ -160,6 +181,7 @@ void Server::Shutdown() {
   if (server_ && server_->GetHealthCheckService()) {
     server_->GetHealthCheckService()->SetServingStatus(false);
   }
+  if (web_) web_->Stop();
   manager_->Shutdown(options_.shutdown_grace);
   if (server_) {
     server_->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(2));

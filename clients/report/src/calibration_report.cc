@@ -577,4 +577,13 @@ std::string RenderNoiseFitReport(const v1::NoiseModelFit& fit, const std::string
   return html + "</body>\n</html>\n";
 }
 
+std::string NoiseFitTitle(const v1::NoiseModelFit& fit) {
+  std::string title;
+  for (const v1::AllanCurve& curve : fit.curves()) {
+    if (!title.empty()) title += ", ";
+    title += curve.column();
+  }
+  return title.empty() ? "noise-model fit" : title;
+}
+
 }  // namespace driftlab::app

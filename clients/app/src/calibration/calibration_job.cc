@@ -5,6 +5,7 @@
 #include "driftlab/app/calibration_job.h"
 
 #include <fmt/format.h>
+#include <google/protobuf/util/json_util.h>
 
 #include <algorithm>
 #include <charconv>
@@ -768,6 +769,29 @@ v1::NoiseModelFit RunNoiseFit(const NoiseFitSettings& settings, const NumericTab
   out.set_fit_time_s(
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   return out;
+}
+
+std::string CalibrationResultToJson(const v1::CalibrationResult& result) {
+  google::protobuf::util::JsonPrintOptions print;
+  print.add_whitespace = true;
+  print.preserve_proto_field_names = true;
+  print.always_print_primitive_fields = true;
+  std::string json;
+  if (!google::protobuf::util::MessageToJsonString(result, &json, print).ok()) {
+    throw SpecError("result", "the calibration result cannot be printed as JSON", 0);
+  }
+  return json;
+}
+
+std::string NoiseModelFitToJson(const v1::NoiseModelFit& fit) {
+  google::protobuf::util::JsonPrintOptions print;
+  print.add_whitespace = true;
+  print.preserve_proto_field_names = true;
+  std::string json;
+  if (!google::protobuf::util::MessageToJsonString(fit, &json, print).ok()) {
+    throw SpecError("result", "the noise-model fit cannot be printed as JSON", 0);
+  }
+  return json;
 }
 
 }  // namespace driftlab::app

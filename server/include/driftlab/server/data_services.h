@@ -6,7 +6,11 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
+#include <string>
+#include <vector>
 
+#include "driftlab/server/job_store.h"
 #include "driftlab/server/service_common.h"
 #include "driftlab/v1/service.grpc.pb.h"
 
@@ -17,8 +21,18 @@ namespace driftlab::server {
 std::unique_ptr<v1::Catalog::Service> MakeCatalogService(const Authenticator* auth,
                                                          std::filesystem::path examples_dir);
 
+// `store` (may be null): every Calibrate and FitNoiseModel call that returns a result is recorded
+// there (JobStore::InsertCalibration) for the web pages; a failure to record is logged, and the
+// call still returns its result.
 std::unique_ptr<v1::Calibration::Service> MakeCalibrationService(const Authenticator* auth,
-                                                                 const ServerLimits& limits);
+                                                                 const ServerLimits& limits,
+                                                                 JobStore* store = nullptr);
+
+// The IMU catalogue as Catalog.ListPresets and Catalog.GetPreset answer (catalog_service.cc): the
+// summaries of every preset, and one preset with its sensor model in the job schema's datasheet
+// units (none for an unknown name).
+std::vector<v1::PresetSummary> PresetSummaries();
+std::optional<v1::Preset> FindPreset(const std::string& name);
 
 std::unique_ptr<v1::Datasets::Service> MakeDatasetsService(const Authenticator* auth,
                                                            const ServerLimits& limits);

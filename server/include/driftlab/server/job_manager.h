@@ -126,6 +126,8 @@ class JobManager {
   // True when the job runs on the cluster: a backend is configured and the job is over its
   // threshold (and not itself a shard), or it was handed to the cluster before a restart.
   bool UsesCluster(const StoredJob& row) const;
+  // Records where a cluster job runs, in the store and in memory (JobStatus.cluster).
+  void SetCluster(const std::shared_ptr<LiveJob>& live, const std::string& handle);
   // Marks the job RUNNING in the store and in memory; returns the attempt number.
   uint32_t MarkRunning(const std::shared_ptr<LiveJob>& live);
   // Status of a job from its live entry (queued/running) or the store; mutex_ held for live.

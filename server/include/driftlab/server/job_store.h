@@ -14,6 +14,8 @@
 //  * a stored result is never overwritten or deleted: SQLite triggers abort any UPDATE of a
 //    non-null result and any DELETE of a row with a result;
 //  * on start, RUNNING jobs (interrupted by a crash) go back to QUEUED with their attempts kept.
+// Table `calibrations` (StoredCalibration): one row per successful Calibrate / FitNoiseModel call,
+// immutable (triggers abort UPDATE and DELETE).
 // All methods are thread-safe (one connection behind a mutex; progress is kept in memory by the
 // JobManager, the store sees only state transitions). Errors throw std::runtime_error with the
 // SQLite message.
@@ -25,6 +27,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "driftlab/v1/service.pb.h"
@@ -32,6 +35,9 @@
 struct sqlite3;
 
 namespace driftlab::server {
+
+// A new record id: `prefix` and 24 random hex digits (OpenSSL RAND_bytes), e.g. "job-3f2a...".
+std::string NewStoreId(std::string_view prefix);
 
 // One row of the jobs table (without the result bytes).
 struct StoredJob {
@@ -51,6 +57,22 @@ struct StoredJob {
   uint32_t attempts = 0;
   bool has_result = false;
   std::string cluster;  // "" = runs in the server's process (cluster.h)
+};
+
+// One call of Calibration.Calibrate or Calibration.FitNoiseModel that returned a result (table
+// `calibrations`; rows are never updated or deleted). The uploaded samples are not kept.
+struct StoredCalibration {
+  int64_t seq = 0;  // order of the calls, assigned by InsertCalibration
+  std::string id;   // "cal-" and 24 hex digits
+  std::string owner;
+  std::string kind;      // "calibrate" (v1::CalibrateSettings / CalibrationResult) or "noise_fit"
+                         // (v1::NoiseFitSettings / NoiseModelFit)
+  std::string name;      // CalibrateSettings.data_name, or the fitted columns
+  std::string settings;  // the serialized settings message
+  std::string result;    // the serialized result (empty in List)
+  uint64_t rows = 0;     // rows uploaded
+  double created_unix_s = 0.0;
+  double elapsed_s = 0.0;  // wall time of the call
 };
 
 class JobStore {
@@ -79,10 +101,20 @@ class JobStore {
   void SetCluster(const std::string& id, const std::string& cluster);
   std::optional<std::string> GetResult(const std::string& id) const;
   // The owner's jobs, newest first, with seq < before_seq (0 = from the newest), in `states`
-  // (empty = all), at most `limit`.
+  // (empty = all), whose name contains `name_contains` ignoring ASCII case (empty = all), at most
+  // `limit`.
   std::vector<StoredJob> List(const std::string& owner, const std::vector<v1::JobState>& states,
-                              int64_t before_seq, uint32_t limit) const;
+                              int64_t before_seq, uint32_t limit,
+                              const std::string& name_contains = "") const;
   std::map<v1::JobState, uint32_t> CountByState() const;
+
+  // Inserts a calibration record; sets record->seq.
+  void InsertCalibration(StoredCalibration* record);
+  std::optional<StoredCalibration> GetCalibration(const std::string& id) const;
+  // The owner's calibrations without their result bytes, newest first, with seq < before_seq
+  // (0 = from the newest), at most `limit`.
+  std::vector<StoredCalibration> ListCalibrations(const std::string& owner, int64_t before_seq,
+                                                  uint32_t limit) const;
 
  private:
   void Exec(const char* sql) const;

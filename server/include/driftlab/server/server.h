@@ -1,6 +1,7 @@
 // driftlab-server assembled: the SQLite store, the job manager, the four gRPC services (Jobs,
 // Catalog, Calibration, Datasets), standard health checking (grpc.health.v1) and server
-// reflection, on one listening address with TLS or without.
+// reflection, on one listening address with TLS or without; and, when asked for, the web pages
+// (web_server.h) on their own address, from the same store and job manager with the same tokens.
 #pragma once
 
 #include <grpcpp/grpcpp.h>
@@ -16,6 +17,7 @@
 #include "driftlab/server/job_manager.h"
 #include "driftlab/server/job_store.h"
 #include "driftlab/server/service_common.h"
+#include "driftlab/server/web_server.h"
 
 namespace driftlab::server {
 
@@ -30,6 +32,8 @@ struct ServerOptions {
   ServerLimits limits;
   ClusterOptions cluster;  // kind kNone: every job runs in the server's process
   std::chrono::milliseconds shutdown_grace{10000};  // running jobs may finish for this long
+  // The web pages (web_server.h): off unless web.port >= 0; TLS with tls_cert / tls_key.
+  WebOptions web;
 };
 
 // Blocks SIGTERM and SIGINT in the calling thread. Call it in main before any thread exists:
@@ -51,6 +55,8 @@ class Server {
   Server& operator=(const Server&) = delete;
 
   int port() const { return port_; }
+  // The web pages' port (-1 when they are off).
+  int http_port() const;
   // Graceful shutdown (job_manager.h): stop accepting jobs, drain for the grace period, then stop
   // the gRPC server. Idempotent.
   void Shutdown();
@@ -63,6 +69,7 @@ class Server {
   std::unique_ptr<JobManager> manager_;
   std::vector<std::unique_ptr<grpc::Service>> services_;
   std::unique_ptr<grpc::Server> server_;
+  std::unique_ptr<WebServer> web_;
   int port_ = 0;
   bool shut_down_ = false;
 };

@@ -118,4 +118,11 @@ struct NoiseFitSettings {
 // column and triad.
 v1::NoiseModelFit RunNoiseFit(const NoiseFitSettings& settings, const NumericTable& table);
 
+// The files of a fit, the same bytes wherever they are written (the CLI, the server's web pages):
+// a calibration result as `driftlab calibrate --out` writes it (protobuf JSON, proto field names,
+// every scalar printed), a noise-model fit as `driftlab allan --fit --fit-json` writes it (proto
+// field names). Throw SpecError("result", ...) if protobuf cannot print the message.
+std::string CalibrationResultToJson(const v1::CalibrationResult& result);
+std::string NoiseModelFitToJson(const v1::NoiseModelFit& fit);
+
 }  // namespace driftlab::app

@@ -39,4 +39,8 @@ std::string RenderCalibrationReport(const v1::CalibrationResult& result,
 // `data_name` titles the report (e.g. the CSV path).
 std::string RenderNoiseFitReport(const v1::NoiseModelFit& fit, const std::string& data_name);
 
+// The title of a noise-fit report rendered from the fit alone (`driftlab report FIT.json`, the
+// server's web pages): the analysed columns, "gyro_x, gyro_y, ...".
+std::string NoiseFitTitle(const v1::NoiseModelFit& fit);
+
 }  // namespace driftlab::app
