@@ -9,9 +9,10 @@
 //   * the deviates of the lockstep kernels (random_kernels::GaussianAcrossRuns: Philox4x32-10 and
 //     Box-Muller) for 4 runs;
 //   * 40 blocks (5120 samples at 100 Hz) of the lockstep kernel (lockstep_ned_kernel.h): the
-//     sensor-error step (scale/misalignment, bias, white noise, Gauss-Markov, random walk, one
-//     flicker component, range and quantization) on synthetic increments of a turning,
-//     climbing vehicle, then the WGS-84 NED mechanization with coning/sculling;
+//     sensor-error step (sensors/triad_step.h: scale/misalignment, bias, white noise,
+//     Gauss-Markov, random walk, one flicker component, range and quantization) on synthetic
+//     increments of a turning, climbing vehicle, then the WGS-84 NED mechanization with
+//     coning/sculling (ins/ned_step.h, earth/earth_lanes.h);
 //   * the engine's scalar exp, expm1, log, log1p, atan, atan2, asin, acos, hypot and ln Gamma
 //     (math/elementary_functions.h, the engine's replacements of the C library's) on grids;
 //   * the statistics' error components of the 4 lanes against a truth (nav_error_lanes.h):

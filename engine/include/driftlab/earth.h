@@ -6,31 +6,22 @@
 // Units: SI (metres, seconds, radians). Latitude L_b, longitude lambda_b, height h_b above the
 // ellipsoid.
 //
+// The WGS-84 constants are driftlab/earth_constants.h's; the radii, gravity and rates are computed
+// by the Earth functions written over the lane width (engine/src/earth/earth_lanes.h), which the
+// lockstep runs use at W lanes, so every path sees the same physics, to the bit.
+//
 // References: NIMA TR8350.2 (WGS-84, 3rd ed., 2000); Groves, "Principles of GNSS, Inertial, and
 // Multisensor Integrated Navigation Systems", 2nd ed. (2013), sections 2.4 and 2.4.7.
 #pragma once
 
 #include <Eigen/Core>
 
+#include "driftlab/earth_constants.h"
+
 namespace driftlab {
 
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
-
-// WGS-84 defining and derived constants (NIMA TR8350.2 tables 3.1 and 3.3).
-inline constexpr double kWgs84SemiMajorAxis_m = 6378137.0;       // a, R_0
-inline constexpr double kWgs84Flattening = 1.0 / 298.257223563;  // f
-inline constexpr double kWgs84Eccentricity2 =                    // e^2 = f (2 - f)
-    kWgs84Flattening * (2.0 - kWgs84Flattening);
-inline constexpr double kWgs84SemiMinorAxis_m =  // b = a (1 - f)
-    kWgs84SemiMajorAxis_m * (1.0 - kWgs84Flattening);
-inline constexpr double kWgs84EarthRate_rad_per_s = 7.292115e-5;     // omega_ie
-inline constexpr double kWgs84GM_m3_per_s2 = 3.986004418e14;         // mu
-inline constexpr double kWgs84GammaEquator_m_per_s2 = 9.7803253359;  // normal gravity, L = 0
-inline constexpr double kWgs84GammaPole_m_per_s2 = 9.8321849378;     // normal gravity, L = 90 deg
-
-// Standard gravity (CGPM 1901), used only for converting g-based datasheet units.
-inline constexpr double kStandardGravity_m_per_s2 = 9.80665;
 
 // Meridian radius of curvature R_N(L) = a (1 - e^2) / (1 - e^2 sin^2 L)^(3/2). Groves (2.105).
 double MeridianRadius(double L_b);
@@ -91,7 +82,9 @@ class NavEnvironment {
   static NavEnvironment Wgs84();
   static NavEnvironment Flat(const Llh& reference, double gravity_m_per_s2);
 
-  EarthModel model() const { return model_; }
+  EarthModel model() const { return params_.flat ? EarthModel::kFlat : EarthModel::kWgs84; }
+  // The environment as plain data (the lane code's view, earth_constants.h).
+  const EarthParams& params() const { return params_; }
   // Radii used for d(L)/dt = v_N / (R_N + h) and d(lambda)/dt = v_E / ((R_E + h) cos L).
   double MeridianRadiusAt(double L_b) const;
   double TransverseRadiusAt(double L_b) const;
@@ -128,10 +121,7 @@ class NavEnvironment {
                             const PositionScale& scale) const;
 
  private:
-  EarthModel model_ = EarthModel::kWgs84;
-  double flat_R_N_m_ = 0.0;
-  double flat_R_E_m_ = 0.0;
-  double flat_gravity_m_per_s2_ = 0.0;
+  EarthParams params_;  // WGS-84 by default
 };
 
 }  // namespace driftlab

@@ -229,9 +229,10 @@ class TriadErrorSimulator {
   int independent_ch_ = -1, gm_ch_ = -1, rw_ch_ = -1, flicker_ch_ = -1;
   std::vector<Channel> channels_;
 
-  // The increment step is the lockstep kernel's at one lane (Kernel<1>::TriadStep in
-  // engine/src/lockstep/lockstep_ned_kernel.h); these are its job constants (the lockstep runs'
-  // struct) and run state, with the field names of lockstep::TriadLanes (one double per lane).
+  // The increment step is the triad error step at one lane (TriadStep<1>, engine/src/sensors/
+  // triad_step.h, which the lockstep runs run at W lanes); these are its job constants (the
+  // lockstep runs' struct) and run state, with the field names of lockstep::TriadLanes (one double
+  // per lane).
   struct StepState {
     double scale_misalignment[3][3] = {};  // [row][column]
     double constant_bias[3] = {};

@@ -1,9 +1,9 @@
-// Job constants of one sensor triad's error step, flattened for the lane kernel
-// (engine/src/lockstep/lockstep_ned_kernel.h, TriadStep): the lockstep runs hold one per triad, and
+// Job constants of one sensor triad's error step, flattened for the step written over the lane
+// width (engine/src/sensors/triad_step.h, TriadStep): the lockstep runs hold one per triad, and
 // TriadErrorSimulator runs the same step at one lane with the same struct. Plain data with no
-// library types, so the per-instruction-set kernel files can include it (engine/src/
-// lockstep_lanes.h explains why they must not share inline code). Filled by TriadStepParamsOf
-// (sensors.h) from TriadJobConstants.
+// library types, so the per-instruction-set kernel files can include it (engine/src/lanes/lane.h
+// explains why they must not share inline code). Filled by TriadStepParamsOf (sensors.h) from
+// TriadJobConstants.
 #pragma once
 
 namespace driftlab {

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "driftlab/elementary.h"
+#include "earth/earth_lanes.h"
 #include "math/elementary_functions.h"
 #include "stats/nav_error_lanes.h"
 
@@ -15,89 +16,49 @@ namespace {
 struct SinCosOf {
   double s, c;
   explicit SinCosOf(double x) { elementary::SinCos<1>(x, s, c); }
-  explicit SinCosOf(const NavEnvironment::Latitude& L) : s(L.sin_L), c(L.cos_L) {}
 };
 double Sin(double x) { return SinCosOf(x).s; }
 double Cos(double x) { return SinCosOf(x).c; }
 
-// The formulas below take sin L, computed once per call of the public functions.
-double MeridianRadiusOfSin(double s) {
-  const double d = 1.0 - kWgs84Eccentricity2 * s * s;
-  return kWgs84SemiMajorAxis_m * (1.0 - kWgs84Eccentricity2) / (d * std::sqrt(d));
+Vector3d ToVector(const vector_lanes::V3<1>& v) { return Vector3d(v.x, v.y, v.z); }
+vector_lanes::V3<1> ToLanes(const Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+earth_lanes::Lat<1> LatOf(const NavEnvironment::Latitude& L) {
+  return earth_lanes::LatOfSinCos<1>(L.L_rad, L.sin_L, L.cos_L);
 }
 
-double TransverseRadiusOfSin(double s) {
-  return kWgs84SemiMajorAxis_m / std::sqrt(1.0 - kWgs84Eccentricity2 * s * s);
+// The Lat that earth_lanes' environment functions read: a flat environment reads none of it, so
+// only WGS-84 computes sin, cos and the radii.
+earth_lanes::Lat<1> LatFor(const EarthParams& e, double L_b) {
+  if (e.flat) return {L_b, 0.0, 1.0, 0.0, 0.0};
+  return earth_lanes::LatOf<1>(L_b);
 }
-
-// Both radii of curvature from one square root: the operations of MeridianRadiusOfSin and
-// TransverseRadiusOfSin (the same d and sqrt(d)), so the same bits.
-struct RadiiOfSin {
-  double R_N, R_E;
-  explicit RadiiOfSin(double s) {
-    const double d = 1.0 - kWgs84Eccentricity2 * s * s;
-    const double sqrt_d = std::sqrt(d);
-    R_N = kWgs84SemiMajorAxis_m * (1.0 - kWgs84Eccentricity2) / (d * sqrt_d);
-    R_E = kWgs84SemiMajorAxis_m / sqrt_d;
-  }
-};
-
-double SomiglianaGravityOfSin(double s) {
-  // k = b gamma_p / (a gamma_e) - 1, Groves (2.134) / NIMA TR8350.2 (4-1).
-  const double k = kWgs84SemiMinorAxis_m * kWgs84GammaPole_m_per_s2 /
-                       (kWgs84SemiMajorAxis_m * kWgs84GammaEquator_m_per_s2) -
-                   1.0;
-  const double s2 = s * s;
-  return kWgs84GammaEquator_m_per_s2 * (1.0 + k * s2) / std::sqrt(1.0 - kWgs84Eccentricity2 * s2);
+earth_lanes::Lat<1> LatFor(const EarthParams& e, const NavEnvironment::Latitude& L) {
+  if (e.flat) return {L.L_rad, L.sin_L, L.cos_L, 0.0, 0.0};
+  return LatOf(L);
 }
 
 }  // namespace
 
-double MeridianRadius(double L_b) { return MeridianRadiusOfSin(Sin(L_b)); }
+double MeridianRadius(double L_b) { return earth_lanes::RadiiOfSin<1>(Sin(L_b)).R_N; }
 
-double TransverseRadius(double L_b) { return TransverseRadiusOfSin(Sin(L_b)); }
+double TransverseRadius(double L_b) { return earth_lanes::RadiiOfSin<1>(Sin(L_b)).R_E; }
 
-double SomiglianaGravity(double L_b) { return SomiglianaGravityOfSin(Sin(L_b)); }
+double SomiglianaGravity(double L_b) { return earth_lanes::SomiglianaGravityOfSin<1>(Sin(L_b)); }
 
-namespace {
-
-// GravityNed, EarthRateNed and TransportRateNed of a latitude's sin and cos
-// (NavEnvironment::AtPoint computes those once for all three).
-Vector3d GravityNedOf(const SinCosOf& sc, double h_b) {
-  const double a = kWgs84SemiMajorAxis_m;
-  const double f = kWgs84Flattening;
-  const double s = sc.s;
-  const double s2 = s * s;
-  // m = omega_ie^2 a^2 b / mu, the ratio of centrifugal to gravitational acceleration at the
-  // equator (NIMA TR8350.2 table 3.3: 0.00344978650684).
-  const double m = kWgs84EarthRate_rad_per_s * kWgs84EarthRate_rad_per_s * a * a *
-                   kWgs84SemiMinorAxis_m / kWgs84GM_m3_per_s2;
-  const double g0 = SomiglianaGravityOfSin(s);
-  const double g_D =
-      g0 * (1.0 - 2.0 / a * (1.0 + f * (1.0 - 2.0 * s2) + m) * h_b + 3.0 * h_b * h_b / (a * a));
-  const double g_N = -8.08e-9 * h_b * (2.0 * s * sc.c);  // sin 2L = 2 sin L cos L
-  return Vector3d(g_N, 0.0, g_D);
+Vector3d GravityNed(double L_b, double h_b) {
+  const SinCosOf L(L_b);
+  return ToVector(earth_lanes::Wgs84Gravity<1>(L.s, L.c, h_b));
 }
 
-Vector3d EarthRateNedOf(const SinCosOf& L) {
-  return Vector3d(kWgs84EarthRate_rad_per_s * L.c, 0.0, -kWgs84EarthRate_rad_per_s * L.s);
+Vector3d EarthRateNed(double L_b) {
+  const SinCosOf L(L_b);
+  return ToVector(earth_lanes::Wgs84EarthRate<1>(L.s, L.c));
 }
-
-Vector3d TransportRateNedOf(const SinCosOf& L, double h_b, const Vector3d& v_eb_n) {
-  const RadiiOfSin radii(L.s);
-  const double R_E = radii.R_E + h_b;
-  const double R_N = radii.R_N + h_b;
-  return Vector3d(v_eb_n.y() / R_E, -v_eb_n.x() / R_N, -v_eb_n.y() * (L.s / L.c) / R_E);
-}
-
-}  // namespace
-
-Vector3d GravityNed(double L_b, double h_b) { return GravityNedOf(SinCosOf(L_b), h_b); }
-
-Vector3d EarthRateNed(double L_b) { return EarthRateNedOf(SinCosOf(L_b)); }
 
 Vector3d TransportRateNed(double L_b, double h_b, const Vector3d& v_eb_n) {
-  return TransportRateNedOf(SinCosOf(L_b), h_b, v_eb_n);
+  return ToVector(
+      earth_lanes::Wgs84TransportRate<1>(earth_lanes::LatOf<1>(L_b), h_b, ToLanes(v_eb_n)));
 }
 
 Vector3d LlhToEcef(const Llh& llh) {
@@ -166,36 +127,38 @@ NavEnvironment NavEnvironment::Wgs84() { return NavEnvironment(); }
 
 NavEnvironment NavEnvironment::Flat(const Llh& reference, double gravity_m_per_s2) {
   NavEnvironment env;
-  env.model_ = EarthModel::kFlat;
+  env.params_.flat = 1;
   // Radii frozen at the reference point; for the flat frame they only scale metres to the
   // latitude/longitude bookkeeping and back, so any positive constant gives the same metres.
-  env.flat_R_N_m_ = MeridianRadius(reference.lat_rad) + reference.h_m;
-  env.flat_R_E_m_ = TransverseRadius(reference.lat_rad) + reference.h_m;
-  env.flat_gravity_m_per_s2_ = gravity_m_per_s2;
+  env.params_.flat_R_N_m = MeridianRadius(reference.lat_rad) + reference.h_m;
+  env.params_.flat_R_E_m = TransverseRadius(reference.lat_rad) + reference.h_m;
+  env.params_.flat_gravity_m_per_s2 = gravity_m_per_s2;
   return env;
 }
 
 double NavEnvironment::MeridianRadiusAt(double L_b) const {
-  return model_ == EarthModel::kFlat ? flat_R_N_m_ : MeridianRadius(L_b);
+  return params_.flat ? params_.flat_R_N_m : MeridianRadius(L_b);
 }
 
 double NavEnvironment::TransverseRadiusAt(double L_b) const {
-  return model_ == EarthModel::kFlat ? flat_R_E_m_ : TransverseRadius(L_b);
+  return params_.flat ? params_.flat_R_E_m : TransverseRadius(L_b);
 }
 
+// The environment's rates and gravity are earth_lanes' at one lane.
+
 Vector3d NavEnvironment::Gravity(double L_b, double h_b) const {
-  if (model_ == EarthModel::kFlat) return Vector3d(0.0, 0.0, flat_gravity_m_per_s2_);
-  return GravityNed(L_b, h_b);
+  const earth_lanes::Lat<1> L = LatFor(params_, L_b);
+  return ToVector(earth_lanes::Gravity<1>(params_, L.s, L.c, h_b));
 }
 
 Vector3d NavEnvironment::EarthRate(double L_b) const {
-  if (model_ == EarthModel::kFlat) return Vector3d::Zero();
-  return EarthRateNed(L_b);
+  const earth_lanes::Lat<1> L = LatFor(params_, L_b);
+  return ToVector(earth_lanes::EarthRate<1>(params_, L.s, L.c));
 }
 
 Vector3d NavEnvironment::TransportRate(double L_b, double h_b, const Vector3d& v_eb_n) const {
-  if (model_ == EarthModel::kFlat) return Vector3d::Zero();
-  return TransportRateNed(L_b, h_b, v_eb_n);
+  return ToVector(
+      earth_lanes::TransportRate<1>(params_, LatFor(params_, L_b), h_b, ToLanes(v_eb_n)));
 }
 
 NavEnvironment::Latitude NavEnvironment::Latitude::Of(double L_rad) {
@@ -219,29 +182,18 @@ NavEnvironment::PointRates NavEnvironment::AtPoint(double L_b, double h_b,
 
 NavEnvironment::PointRates NavEnvironment::AtPoint(const Latitude& lat, double h_b,
                                                    const Vector3d& v_eb_n) const {
-  if (model_ == EarthModel::kFlat) {
-    return {Vector3d::Zero(), Vector3d::Zero(), Vector3d(0.0, 0.0, flat_gravity_m_per_s2_)};
-  }
-  const SinCosOf L(lat);
-  return {EarthRateNedOf(L), TransportRateNedOf(L, h_b, v_eb_n), GravityNedOf(L, h_b)};
+  const earth_lanes::Lat<1> L = LatFor(params_, lat);
+  return {ToVector(earth_lanes::EarthRate<1>(params_, L.s, L.c)),
+          ToVector(earth_lanes::TransportRate<1>(params_, L, h_b, ToLanes(v_eb_n))),
+          ToVector(earth_lanes::Gravity<1>(params_, L.s, L.c, h_b))};
 }
 
 Vector3d NavEnvironment::LlhRate(double L_b, double h_b, const Vector3d& v_eb_n) const {
-  if (model_ == EarthModel::kFlat) {
-    // Flat frame: h plays no part in the metre scaling and there is no convergence of meridians.
-    return Vector3d(v_eb_n.x() / flat_R_N_m_, v_eb_n.y() / flat_R_E_m_, -v_eb_n.z());
-  }
-  return LlhRate(Latitude::Of(L_b), h_b, v_eb_n);
+  return ToVector(earth_lanes::LlhRate<1>(params_, LatFor(params_, L_b), h_b, ToLanes(v_eb_n)));
 }
 
 Vector3d NavEnvironment::LlhRate(const Latitude& lat, double h_b, const Vector3d& v_eb_n) const {
-  if (model_ == EarthModel::kFlat) {
-    return Vector3d(v_eb_n.x() / flat_R_N_m_, v_eb_n.y() / flat_R_E_m_, -v_eb_n.z());
-  }
-  const SinCosOf L(lat);
-  const RadiiOfSin radii(L.s);
-  return Vector3d(v_eb_n.x() / (radii.R_N + h_b), v_eb_n.y() / ((radii.R_E + h_b) * L.c),
-                  -v_eb_n.z());
+  return ToVector(earth_lanes::LlhRate<1>(params_, LatFor(params_, lat), h_b, ToLanes(v_eb_n)));
 }
 
 Vector3d NavEnvironment::PositionErrorNed(const Llh& estimate, const Llh& truth) const {
@@ -249,7 +201,7 @@ Vector3d NavEnvironment::PositionErrorNed(const Llh& estimate, const Llh& truth)
 }
 
 NavEnvironment::PositionScale NavEnvironment::PositionScaleAt(const Llh& truth) const {
-  if (model_ == EarthModel::kFlat) return {flat_R_N_m_, flat_R_E_m_, 1.0};
+  if (params_.flat) return {params_.flat_R_N_m, params_.flat_R_E_m, 1.0};
   // First-order curvilinear-to-metre scaling, Groves (2.119); exact to ~1e-7 relative for the
   // position errors of interest (< 100 km).
   return {MeridianRadius(truth.lat_rad) + truth.h_m, TransverseRadius(truth.lat_rad) + truth.h_m,

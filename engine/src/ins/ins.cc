@@ -5,25 +5,22 @@
 #include <string>
 
 #include "driftlab/spec_error.h"
-// The lane kernel has internal linkage (its own anonymous namespace): this file's Kernel<1> is
-// compiled with this file's options only and shares no inline code with the kernel files built
-// for other instruction sets.
-#include "lockstep/lockstep_ned_kernel.h"
+// The step over the lane width (internal linkage: this file's copy at W = 1 shares no inline code
+// with the lockstep kernel files built for other instruction sets).
+#include "ins/ned_step.h"
 
 namespace driftlab {
 
 namespace {
 
-using Kernel1 = lockstep::Kernel<1>;
-
-// What Kernel<1>::NedStep reads of the job (lockstep::KernelJob's fields of the same names).
+// What NedStep reads of the job (lockstep::KernelJob's fields of the same names).
 struct NedStepJob {
-  lockstep::EarthParams earth;
+  EarthParams earth;
   double dt_s = 0.0;
   int coning_sculling = 1;
 };
 
-// NedMechanization's state as Kernel<1>::NedStep reads and writes it: lockstep::NavLanes's
+// NedMechanization's state as NedStep<1> reads and writes it: lockstep::NavLanes's
 // fields with one double per lane.
 struct NedStepState {
   double lat_rad, lon_rad, h_m;
@@ -67,18 +64,12 @@ void NedMechanization::SetVertical(double h_m, double v_D_m_per_s) {
 }
 
 void NedMechanization::Update(const ImuIncrement& increment) {
-  // The step is the lockstep kernel's, at one lane (lockstep_ned_kernel.h: Kernel<1>::NedStep,
-  // which documents the algorithm): the same code for one run here and for W runs at once.
+  // The step at one lane (ins/ned_step.h, which documents the algorithm): the same code for one
+  // run here and for W runs at once in the lockstep runs.
   NedStepJob job;
+  job.earth = env_.params();
   job.dt_s = dt_s_;
   job.coning_sculling = options_.coning_sculling ? 1 : 0;
-  if (env_.model() == EarthModel::kFlat) {
-    // The flat environment's constants, read through its accessors (any latitude gives them).
-    job.earth.flat = 1;
-    job.earth.flat_R_N_m = env_.MeridianRadiusAt(0.0);
-    job.earth.flat_R_E_m = env_.TransverseRadiusAt(0.0);
-    job.earth.flat_gravity_m_per_s2 = env_.Gravity(0.0, 0.0).z();
-  }
   const Vector3d& dtheta = increment.delta_theta_ib_b;
   const Vector3d& dv = increment.delta_v_ib_b;
   const Vector3d& previous_dtheta = previous_.delta_theta_ib_b;
@@ -93,7 +84,7 @@ void NedMechanization::Update(const ImuIncrement& increment) {
                  {previous_dv.x(), previous_dv.y(), previous_dv.z()},
                  {previous_v_eb_n_.x(), previous_v_eb_n_.y(), previous_v_eb_n_.z()},
                  have_previous_ ? 1 : 0};
-  Kernel1::NedStep(job, s, {dtheta.x(), dtheta.y(), dtheta.z()}, {dv.x(), dv.y(), dv.z()});
+  ned_step::NedStep<1>(job, s, {dtheta.x(), dtheta.y(), dtheta.z()}, {dv.x(), dv.y(), dv.z()});
   state_.q_b_n = Quaterniond(s.q_b_n[0], s.q_b_n[1], s.q_b_n[2], s.q_b_n[3]);
   previous_v_eb_n_ = Vector3d(s.previous_v_eb_n[0], s.previous_v_eb_n[1], s.previous_v_eb_n[2]);
   previous_ = increment;

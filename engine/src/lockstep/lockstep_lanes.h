@@ -6,6 +6,7 @@
 
 #include <cstdint>
 
+#include "driftlab/earth_constants.h"
 #include "driftlab/triad_step_params.h"
 #include "stats/nav_error_lanes.h"
 
@@ -20,19 +21,13 @@ inline constexpr int kMaxFlicker = kTriadStepMaxFlicker;  // kMaxFlickerComponen
 // Job constants of one triad (TriadJobConstants, flattened for the kernel; TriadStepParamsOf).
 using TriadParams = ::driftlab::TriadStepParams;
 
-// Earth model constants of the job (NavEnvironment without the per-call branch on its kind).
-struct EarthParams {
-  int flat = 0;
-  double flat_R_N_m = 0.0, flat_R_E_m = 0.0, flat_gravity_m_per_s2 = 0.0;
-};
-
 // What the kernel reads of the job.
 struct KernelJob {
   int has_sensor = 0;
   TriadParams triad[2];  // 0 = gyro, 1 = accel
   int g_sensitivity = 0;
   double gyro_g_sensitivity[3][3] = {};
-  EarthParams earth;
+  EarthParams earth;  // NavEnvironment::params()
   double dt_s = 0.0;
   int coning_sculling = 1;
   int truth_height = 0;

@@ -46,13 +46,7 @@ LockstepJob ComposeJob(const ImuErrorModel* model, uint64_t seed, const NavEnvir
   k.dt_s = 1.0 / rate_hz;
   k.coning_sculling = options.coning_sculling;
   k.truth_height = options.vertical == VerticalChannel::kTruthHeight;
-  if (env.model() == EarthModel::kFlat) {
-    // The flat environment's constants, read through its accessors (any latitude gives them).
-    k.earth.flat = 1;
-    k.earth.flat_R_N_m = env.MeridianRadiusAt(0.0);
-    k.earth.flat_R_E_m = env.TransverseRadiusAt(0.0);
-    k.earth.flat_gravity_m_per_s2 = env.Gravity(0.0, 0.0).z();
-  }
+  k.earth = env.params();
   if (model != nullptr) {
     ValidateImuErrorModel(*model, "sensor");
     job.model = *model;

@@ -1,5 +1,7 @@
 // Lockstep runner of the free-inertial NED Monte-Carlo path: W runs advance together, their state
-// stored as structure of arrays across runs (lanes). Internal to the engine.
+// stored as structure of arrays across runs (lanes). Internal to the engine. This folder holds only
+// what runs W lanes; the physics it runs is written once over the lane width in its concern's
+// folder (sensors/triad_step.h, ins/ned_step.h, earth/earth_lanes.h, stats/nav_error_lanes.h).
 //
 // Split:
 //  * LockstepJob: the job constants, composed once per job (sensor model incl. the flicker design
@@ -11,16 +13,16 @@
 //    error step, then the mechanization step (or, in the alignment window, the sums of the measured
 //    increments).
 //
-// Same bits as the scalar code: the kernel performs, lane by lane, the same IEEE operations in
-// the same order as ImuErrorSimulator::Apply (sensors.cc) and NedMechanization::Update (ins.cc,
-// with Eigen 3.4's operation order for quaternion products, rotation of vectors and norms), sin
-// and cos being the engine's own (math/elementary_functions.h), as in the scalar earth.cc and attitude.cc;
-// -ffp-contract=off everywhere. Deviates come from the same RandomStream keys and
-// indices. So a run's result is the same whichever lane, group, thread, shard or instruction set
-// computes it, and equal to the scalar RunNed's (lockstep_ned_test.cc checks all of this).
-// (The equality between lockstep paths holds for any build; the equality with RunNed assumes
-// Eigen's operation order of the default x86-64 / arm64 build, which a build of the scalar code
-// with wider Eigen packets, e.g. -march=native with AVX, could change.)
+// Same bits as the scalar code: the scalar code runs the same steps at W = 1
+// (TriadErrorSimulator::ApplyIncrement, sensors.cc; NedMechanization::Update, ins.cc), lane-wise
+// IEEE operations in Eigen 3.4's order for quaternion products, rotation of vectors and norms
+// (math/vector_lanes.h), sin and cos being the engine's own (math/elementary_functions.h);
+// -ffp-contract=off everywhere. Deviates come from the same RandomStream keys and indices. So a
+// run's result is the same whichever lane, group, thread, shard or instruction set computes it,
+// and equal to the scalar RunNed's (lockstep_ned_test.cc checks all of this). (The equality
+// between lockstep paths holds for any build; the equality with RunNed's Eigen code elsewhere in
+// the run assumes Eigen's operation order of the default x86-64 / arm64 build, which a build with
+// wider Eigen packets, e.g. -march=native with AVX, could change.)
 #pragma once
 
 #include <cstdint>

@@ -4,6 +4,7 @@
 
 #include "driftlab/elementary.h"
 #include "math/elementary_functions.h"
+#include "math/vector_lanes.h"
 #include "stats/nav_error_lanes.h"
 
 namespace driftlab {
@@ -64,21 +65,10 @@ Matrix3d RotationVectorToDcm(const Vector3d& rho) {
 }
 
 Quaterniond RotationVectorToQuaternion(const Vector3d& rho) {
-  const double a2 = rho.squaredNorm();
-  const double a = std::sqrt(a2);
-  double w, k;  // cos(a/2) and sin(a/2)/a
-  if (a < 1e-4) {
-    // Products with the rounded reciprocals, as the lockstep kernel (lockstep_ned_kernel.h).
-    w = 1.0 - a2 * (1.0 / 8.0) + a2 * a2 * (1.0 / 384.0);
-    k = 0.5 - a2 * (1.0 / 48.0) + a2 * a2 * (1.0 / 3840.0);
-  } else {
-    double sin_half,
-        cos_half;  // the engine's own (math/elementary_functions.h), as the lockstep kernels
-    elementary::SinCos<1>(0.5 * a, sin_half, cos_half);
-    w = cos_half;
-    k = sin_half / a;
-  }
-  return Quaterniond(w, k * rho.x(), k * rho.y(), k * rho.z());
+  // The mechanization's code at one lane (math/vector_lanes.h).
+  const vector_lanes::Q4<1> q =
+      vector_lanes::RotationVectorToQuaternion<1>({rho.x(), rho.y(), rho.z()});
+  return Quaterniond(q.w, q.x, q.y, q.z);
 }
 
 Vector3d QuaternionToRotationVector(const Quaterniond& q_in) {

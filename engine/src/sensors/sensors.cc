@@ -12,10 +12,9 @@
 
 #include "driftlab/elementary.h"
 #include "driftlab/spec_error.h"
-// The lane kernel has internal linkage (its own anonymous namespace): this file's Kernel<1> is
-// compiled with this file's options only and shares no inline code with the kernel files built
-// for other instruction sets.
-#include "lockstep/lockstep_ned_kernel.h"
+// The step over the lane width (internal linkage: this file's copy at W = 1 shares no inline code
+// with the lockstep kernel files built for other instruction sets).
+#include "sensors/triad_step.h"
 
 namespace driftlab {
 namespace {
@@ -411,7 +410,8 @@ Eigen::Vector3d TriadErrorSimulator::ApplyIncrement(const Eigen::Vector3d& ideal
                                                     const Eigen::Vector3d& additive) {
   const double dt = dt_s_;
   const uint64_t k = static_cast<uint64_t>(step_);
-  // The lockstep kernel's step at one lane, its deviates from this run's channels.
+  // The triad's error step at one lane (sensors/triad_step.h), its deviates from this run's
+  // channels.
   struct Deviates {
     TriadErrorSimulator* s;
     uint64_t k;
@@ -424,8 +424,8 @@ Eigen::Vector3d TriadErrorSimulator::ApplyIncrement(const Eigen::Vector3d& ideal
     }
   };
   const Deviates dev{this, k};
-  const auto out = lockstep::Kernel<1>::TriadStep(step_params_, state_, dev, ideal.data(),
-                                                  additive.data(), k, dt);
+  const auto out =
+      triad_step::TriadStep<1>(step_params_, state_, dev, ideal.data(), additive.data(), k, dt);
   ++step_;
   return Eigen::Vector3d(out.x, out.y, out.z);
 }
