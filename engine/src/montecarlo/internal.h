@@ -15,10 +15,12 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "driftlab/aiding.h"
 #include "driftlab/error_state.h"
 #include "driftlab/monte_carlo.h"
 #include "montecarlo/run_loop.h"
@@ -63,14 +65,18 @@ struct SharedTruth {
   // Truth-height aiding: h and v_D at every sample.
   std::vector<double> h_m, v_D_m_per_s;
   std::vector<Report> reports;  // ascending k, all >= start_step
-  // Aiding: truth at the GNSS epochs j (sample j * gnss_decimation) and the ideal body rate there;
-  // truth height at the barometer epochs; truth attitude at the magnetometer epochs; ZUPT samples.
-  int64_t gnss_decimation = 0, baro_decimation = 0, mag_decimation = 0;
-  std::vector<NavState> gnss_truth;
-  std::vector<Vector3d> gnss_omega_ib_b;
-  std::vector<double> baro_h_m;
+  // Aiding (kInsGnssEkf): the one schedule of the job's aids (aiding.h) and, at each sample where
+  // an aid is due (ascending k), the truth it measures. Magnetometer (kComplementary): the truth
+  // attitude at its epochs j (sample j * mag_decimation).
+  std::shared_ptr<const AidingSchedule> schedule;
+  struct AidingEpoch {
+    int64_t k = 0;
+    uint32_t due = 0;  // AidingSchedule::Due
+    AidingTruth truth;
+  };
+  std::vector<AidingEpoch> aiding_epochs;
+  int64_t mag_decimation = 0;
   std::vector<Quaterniond> mag_q_b_n;
-  std::vector<int64_t> zupt_epochs;
   // kInsGnssEkf: the filter's noise model and initial covariance.
   ErrorStateNoise ekf_noise;
   ErrorStateMatrix ekf_P0;
@@ -193,6 +199,7 @@ bool UseGyrocompass(const MonteCarloSpec& spec, const SharedTruth& truth);
 // ---- montecarlo/runs.cc: one run each through run_loop::RunLoop, its reports into `sink`; false
 // if stopped early, else the run is counted as done in `monitor`.
 class Monitor;
+
 bool RunNed(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, bool gyrocompass,
             const RunSink& sink, Monitor* monitor);
 bool RunSeed000(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, const RunSink& sink,

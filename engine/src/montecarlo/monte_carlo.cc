@@ -223,7 +223,7 @@ MonteCarloOutput RunMonteCarloWithAnalysis(
   }
   if (ekf) output.consistency = MergeNees(nees_accumulators, n_epochs);
   if (spec.covariance) {
-    // The analysis at the epochs' samples, the ZUPT epochs as the runs use them.
+    // The analysis at the epochs' samples, with the runs' aiding schedule.
     std::vector<int64_t> epoch_samples;
     for (const Report& r : truth.reports) {
       if (r.epoch >= 0) epoch_samples.push_back(r.k);
@@ -236,7 +236,7 @@ MonteCarloOutput RunMonteCarloWithAnalysis(
     // that filter; the free INS's uses covariance_step_samples with Van Loan's exact transition.
     analysis.epochs = FilterCovarianceAnalysis(
         spec.simulation.motion, spec.simulation.rate_hz, truth.ekf_noise, truth.ekf_P0,
-        ekf ? &spec.aiding : nullptr, truth.zupt_epochs, epoch_samples, analysis.step_samples,
+        ekf ? truth.schedule.get() : nullptr, epoch_samples, analysis.step_samples,
         ekf ? InsGnssFilterOptions().discretization : Discretization::kVanLoan);
     output.covariance = std::move(analysis);
   }

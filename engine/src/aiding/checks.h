@@ -1,0 +1,30 @@
+// Range checks shared by the aiding sensors' validation (a SpecError naming the field, the value
+// and the allowed range).
+#pragma once
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "driftlab/spec_error.h"
+
+namespace driftlab::aiding_checks {
+
+// The value as the shortest text that reads back exactly ("%.17g").
+inline std::string Num(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.17g", x);
+  return buf;
+}
+
+// A 1-sigma: finite, 0 < (or 0 <= with positive = false) value <= max [unit].
+inline void CheckSigma(double value, const std::string& field, double max, const std::string& unit,
+                       bool positive) {
+  const bool ok = std::isfinite(value) && (positive ? value > 0.0 : value >= 0.0) && value <= max;
+  if (!ok) {
+    throw SpecError(field, Num(value),
+                    std::string(positive ? "0 < " : "0 <= ") + "sigma <= " + Num(max) + " " + unit);
+  }
+}
+
+}  // namespace driftlab::aiding_checks
