@@ -26,9 +26,10 @@ const ImuErrorModel* SensorOf(const MonteCarloSpec& spec) {
 // One run of `navigator` over the shared truth's samples k = 0..n through the run's sensor errors,
 // `record(report, navigator)` at each report sample, progress and cancellation through `monitor`.
 // Returns false if stopped early; else the run's samples are counted as done.
+// `observer` (if not null) sees every sample after its report.
 template <class Navigator, class Record>
 bool RunOne(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, Navigator& navigator,
-            Record&& record, Monitor* monitor) {
+            Record&& record, Monitor* monitor, RunObserver* observer) {
   using Input = typename Navigator::Input;
   constexpr bool kPointSamples = std::is_same_v<Input, ImuSample>;
   const std::vector<Input>* ideal = nullptr;
@@ -40,8 +41,14 @@ bool RunOne(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, Navi
   run_loop::StoredImu<Input> measure(*ideal, SensorOf(spec), spec.seed, run, s.rate_hz);
   size_t next = 0;
   const size_t n_reports = s.reports.size();
+  const InsGnssFilter* filter = nullptr;
+  if constexpr (requires { navigator.filter(); }) filter = &navigator.filter();
+  const std::function<NavState(const NavState&)> solution = [&navigator](const NavState& truth) {
+    return NavState(navigator.Solution(truth));
+  };
   auto report = [&](int64_t k, const Navigator& nav) {
     if (next < n_reports && s.reports[next].k == k) record(s.reports[next++], nav);
+    if (observer != nullptr) observer->At(k, solution, filter);
   };
   int64_t polled = 0;
   auto poll = [&](int64_t k) {
@@ -95,6 +102,7 @@ class EkfNavigator {
   }
   const NavState& Solution(const NavState&) const { return filter_->state(); }
   InsGnssFilter& filter() { return *filter_; }
+  const InsGnssFilter& filter() const { return *filter_; }
 
  private:
   const SharedTruth& s_;
@@ -145,7 +153,7 @@ class ComplementaryNavigator {
 }  // namespace
 
 bool RunNed(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, bool gyrocompass,
-            const RunSink& sink, Monitor* monitor) {
+            const RunSink& sink, Monitor* monitor, RunObserver* observer) {
   run_loop::NedNavigator navigator(
       s.env, s.dt_s, spec.simulation.ned, s.start_step,
       [&](const Eigen::Vector3d& sum_dtheta, const Eigen::Vector3d& sum_dv) {
@@ -160,22 +168,22 @@ bool RunNed(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, bool
       [&](const Report& r, const auto& nav) {
         sink.Record(r, ComputeNavError(s.env, nav.Solution(r.truth), r.truth));
       },
-      monitor);
+      monitor, observer);
 }
 
 bool RunSeed000(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, const RunSink& sink,
-                Monitor* monitor) {
+                Monitor* monitor, RunObserver* observer) {
   run_loop::Seed000Navigator navigator(s.env, s.truth0, s.dt_s, spec.simulation.seed000);
   return RunOne(
       s, spec, run, navigator,
       [&](const Report& r, const run_loop::Seed000Navigator& nav) {
         sink.Record(r, ComputeNavError(s.env, nav.Solution(r.truth), r.truth));
       },
-      monitor);
+      monitor, observer);
 }
 
 bool RunEkf(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, const RunSink& sink,
-            NeesAccumulator* nees, Monitor* monitor) {
+            NeesAccumulator* nees, Monitor* monitor, RunObserver* observer) {
   EkfNavigator navigator(s, spec, run);
   InsGnssFilter& filter = navigator.filter();
   auto record = [&](const Report& r, const EkfNavigator&) {
@@ -193,18 +201,18 @@ bool RunEkf(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, cons
     nees->sum[static_cast<size_t>(r.epoch)].Add(value);
     ++nees->count[static_cast<size_t>(r.epoch)];
   };
-  return RunOne(s, spec, run, navigator, record, monitor);
+  return RunOne(s, spec, run, navigator, record, monitor, observer);
 }
 
 bool RunComplementary(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run,
-                      const RunSink& sink, Monitor* monitor) {
+                      const RunSink& sink, Monitor* monitor, RunObserver* observer) {
   ComplementaryNavigator navigator(s, spec, run);
   return RunOne(
       s, spec, run, navigator,
       [&](const Report& r, const ComplementaryNavigator& nav) {
         sink.Record(r, ComputeNavError(s.env, nav.Solution(r.truth), r.truth));
       },
-      monitor);
+      monitor, observer);
 }
 
 }  // namespace driftlab::mc_detail

@@ -123,6 +123,17 @@ void StreamSharedTruth(const MonteCarloSpec& spec, bool keep_imu, TrajectoryGene
   if (stream != nullptr) stream->Publish(s.n);
 }
 
+ErrorStateNoiseFromImu PrepareFilterModel(const MonteCarloSpec& spec, SharedTruth* s) {
+  ErrorStateNoiseFromImu noise = FilterErrorModel(spec, *s);
+  if (spec.filter == NavigationFilterKind::kInsGnssEkf || spec.covariance) {
+    s->ekf_noise = noise.noise;
+    s->ekf_P0 = InitialErrorCovariance(
+        spec.initial_errors.position_ned_m, spec.initial_errors.velocity_ned_m_per_s,
+        spec.initial_errors.attitude_rad, s->truth_start.euler(), noise.noise);
+  }
+  return noise;
+}
+
 ErrorStateNoiseFromImu FilterErrorModel(const MonteCarloSpec& spec, const SharedTruth& s) {
   const bool ekf = spec.filter == NavigationFilterKind::kInsGnssEkf;
   const double duration_s = static_cast<double>(s.n - s.start_step) * s.dt_s;
