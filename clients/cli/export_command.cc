@@ -1,8 +1,9 @@
-// `driftlab export JOB --out DIR [--seed S] [--run R]`: the IMU data of one seeded run of the job's
-// sensor model, for users who bring their own navigation algorithm: imu.csv (measured increments
-// and point samples), imu_ideal.csv (the error-free data), truth.csv (the reference trajectory),
-// truth_groves.csv (the same in Groves' profile layout) and run.txt (what was run). The job is
-// validated completely before DIR is created.
+// `driftlab export JOB --out DIR [--seed S] [--run R]`: the IMU data of run R of the job's Monte
+// Carlo (the engine's SimulateMonteCarloRun, exactly as `driftlab run` computes that run), for
+// users who bring their own navigation algorithm: imu.csv (measured increments and point samples),
+// imu_ideal.csv (the error-free data), truth.csv (the reference trajectory), truth_groves.csv (the
+// same in Groves' profile layout) and run.txt (what was run). The job is validated completely
+// before DIR is created.
 //
 // With `--server ADDR [--token T] [--tls-ca F]` the server simulates the run (Datasets.ExportRun)
 // and streams it: imu.csv and truth.csv (the same columns and numbers as the local files: the
@@ -23,9 +24,11 @@
 
 #include "commands.h"
 #include "driftlab/app/job_file.h"
+#include "driftlab/app/monte_carlo_job.h"
 #include "driftlab/app/sensor_model.h"
 #include "driftlab/app/translate.h"
 #include "driftlab/io.h"
+#include "driftlab/monte_carlo.h"
 #include "driftlab/simulate.h"
 #include "driftlab/spec_error.h"
 #include "remote_client.h"
@@ -178,19 +181,22 @@ int RunRemoteExport(const ExportOptions& options) {
 int RunExport(const ExportOptions& options) {
   if (!options.remote.server.empty()) return RunRemoteExport(options);
   app::JobFile file;
-  SimulationSpec spec;
-  std::optional<SensorRun> sensor;
+  MonteCarloSpec spec;
   try {
     file = app::LoadJobFile(options.job_path);
-    spec = app::ValidateJob(file);
-    std::optional<ImuErrorModel> model = app::ToImuErrorModel(file.job);
-    if (!model) {
+    app::MonteCarloOverrides overrides;
+    overrides.seed = options.seed;
+    spec = app::ToMonteCarloSpec(file, overrides);
+    if (!spec.sensor) {
       throw SpecError("sensor", "(absent)",
                       "a sensor model (preset or parameters): export writes errored IMU data; "
                       "`driftlab simulate` writes the error-free data");
     }
-    sensor = SensorRun{*std::move(model), options.seed.value_or(app::JobSeed(file.job)),
-                       options.run_index};
+    if (options.run_index >= spec.runs) {
+      throw SpecError("--run", std::to_string(options.run_index),
+                      "< monte_carlo.runs = " + std::to_string(spec.runs) +
+                          " (run R of the job's Monte Carlo)");
+    }
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;
@@ -209,8 +215,8 @@ int RunExport(const ExportOptions& options) {
     GrovesProfileWriter groves(dir / "truth_groves.csv");
     ImuCsvWriter imu(dir / "imu.csv");
     ImuCsvWriter imu_ideal(dir / "imu_ideal.csv");
-    const SimulationSummary summary =
-        RunSimulation(spec, &*sensor, [&](const SimulationStep& step) {
+    const SimulationSummary summary = SimulateMonteCarloRun(
+        spec, options.run_index, [&](const SimulationStep& step, const InsGnssFilter*) {
           const double t_s = step.truth->t_s;
           truth.Write(*step.truth);
           groves.Write(*step.truth);
@@ -224,13 +230,13 @@ int RunExport(const ExportOptions& options) {
     {
       auto run = fmt::output_file((dir / "run.txt").string());
       run.print("job: {}\nname: {}\nsensor model: {}\nseed: {}\nrun: {}\nrate_hz: {:.17g}\n",
-                options.job_path, file.job.name(), sensor->model.name, sensor->seed,
-                sensor->run_index, spec.rate_hz);
+                options.job_path, file.job.name(), spec.sensor->name, spec.seed, options.run_index,
+                spec.simulation.rate_hz);
       run.print("samples: {}\nduration_s: {:.17g}\n", summary.steps + 1, summary.duration_s);
     }
     fmt::print("{}: sensor model {}, seed {}, run {}: {} samples at {:g} Hz ({:.3f} s)\n",
-               file.job.name().empty() ? "(unnamed)" : file.job.name(), sensor->model.name,
-               sensor->seed, sensor->run_index, summary.steps + 1, spec.rate_hz,
+               file.job.name().empty() ? "(unnamed)" : file.job.name(), spec.sensor->name,
+               spec.seed, options.run_index, summary.steps + 1, spec.simulation.rate_hz,
                summary.duration_s);
     fmt::print("wrote imu.csv, imu_ideal.csv, truth.csv, truth_groves.csv, run.txt to {}\n",
                dir.string());

@@ -1,8 +1,13 @@
-// `driftlab simulate JOB --out DIR`: the job's motion through its mechanization on error-free IMU
-// data. The job is validated completely (fields and the planned motion) before DIR is created, so
-// a bad job writes nothing.
+// `driftlab simulate JOB --out DIR [--seed S] [--run N]`: run N of the job's Monte Carlo, sample
+// by sample, exactly as `driftlab run` computes it (the engine's SimulateMonteCarloRun: the run's
+// sensor errors, initial errors, alignment, aiding and filter): truth.csv, imu.csv, imu_ideal.csv
+// (with a sensor model), nav.csv and errors.csv (from the navigation start on) and, for the
+// INS/GNSS EKF, filter.csv (its sensor-error estimates and the 1-sigma of its navigation errors).
+// The job is validated completely (fields and the planned motion) before DIR is created, so a bad
+// job writes nothing.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -13,9 +18,11 @@
 
 #include "commands.h"
 #include "driftlab/app/job_file.h"
+#include "driftlab/app/monte_carlo_job.h"
 #include "driftlab/app/sensor_model.h"
 #include "driftlab/app/translate.h"
 #include "driftlab/io.h"
+#include "driftlab/monte_carlo.h"
 #include "driftlab/simulate.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/units.h"
@@ -23,18 +30,46 @@
 namespace driftlab::cli {
 namespace {
 
-void PrintSummary(const app::JobFile& file, const SimulationSpec& spec, const SensorRun* sensor,
-                  const SimulationSummary& summary, const std::filesystem::path& out_dir) {
+// filter.csv: the EKF's estimates and the sigma of its navigation errors at every sample from the
+// navigation start (the covariance as last propagated: at the output epochs and aiding updates).
+class FilterCsvWriter : public CsvFile {
+ public:
+  explicit FilterCsvWriter(const std::filesystem::path& path)
+      : CsvFile(path,
+                "t_s,accel_bias_x_m_per_s2,accel_bias_y_m_per_s2,accel_bias_z_m_per_s2,"
+                "gyro_bias_x_rad_per_s,gyro_bias_y_rad_per_s,gyro_bias_z_rad_per_s,"
+                "sigma_north_m,sigma_east_m,sigma_down_m,sigma_v_north_m_per_s,"
+                "sigma_v_east_m_per_s,sigma_v_down_m_per_s,sigma_psi_north_rad,"
+                "sigma_psi_east_rad,sigma_psi_down_rad") {}
+  void Write(double t_s, const InsGnssFilter& filter) {
+    double row[16];
+    row[0] = t_s;
+    for (int i = 0; i < 3; ++i) {
+      row[1 + i] = filter.accel_bias()[i];
+      row[4 + i] = filter.gyro_bias()[i];
+    }
+    for (int i = 0; i < 9; ++i) row[7 + i] = std::sqrt(std::max(0.0, filter.P()(i, i)));
+    Row(row, 16);
+  }
+};
+
+void PrintSummary(const app::JobFile& file, const MonteCarloSpec& mc, uint32_t run,
+                  const SimulationSummary& summary, const std::filesystem::path& out_dir,
+                  bool filter) {
+  const SimulationSpec& spec = mc.simulation;
   const std::string name = file.job.name().empty() ? "(unnamed)" : file.job.name();
   fmt::print("{}: {:.3f} s, {} steps at {:g} Hz, {} mechanization, {} earth\n", name,
              summary.duration_s, summary.steps, spec.rate_hz,
              spec.mechanization == MechanizationKind::kNed ? "NED" : "SEED000",
              spec.motion.earth_model == EarthModel::kWgs84 ? "WGS84" : "FLAT");
-  if (sensor != nullptr) {
-    fmt::print("sensor model {}, seed {}, run {}\n", sensor->model.name, sensor->seed,
-               sensor->run_index);
+  if (mc.sensor) {
+    fmt::print("sensor model {}, seed {}, run {} of {} of the job's Monte Carlo\n", mc.sensor->name,
+               mc.seed, run, mc.runs);
   } else {
-    fmt::print("error-free IMU data (the job has no sensor model)\n");
+    fmt::print(
+        "error-free IMU data (the job has no sensor model), seed {}, run {} of {} of the "
+        "job's Monte Carlo\n",
+        mc.seed, run, mc.runs);
   }
   const NavError& final_error = summary.final_error;
   fmt::print("{:<26}{:>14}{:>14}\n", "error", "final", "max");
@@ -51,8 +86,8 @@ void PrintSummary(const app::JobFile& file, const SimulationSpec& spec, const Se
       summary.max_abs_euler_rad.y() * kRadToDeg);
   row("yaw [deg]", std::abs(final_error.euler_rad.z()) * kRadToDeg,
       summary.max_abs_euler_rad.z() * kRadToDeg);
-  fmt::print("wrote truth.csv, imu.csv, {}nav.csv, errors.csv to {}\n",
-             sensor != nullptr ? "imu_ideal.csv, " : "", out_dir.string());
+  fmt::print("wrote truth.csv, imu.csv, {}nav.csv, errors.csv{} to {}\n",
+             mc.sensor ? "imu_ideal.csv, " : "", filter ? ", filter.csv" : "", out_dir.string());
 }
 
 struct SimulateOptions {
@@ -65,14 +100,16 @@ struct SimulateOptions {
 int RunSimulate(const SimulateOptions& options) {
   const std::string& out_dir = options.out_dir;
   app::JobFile file;
-  SimulationSpec spec;
-  std::optional<SensorRun> sensor;
+  MonteCarloSpec spec;
   try {
     file = app::LoadJobFile(options.job_path);
-    spec = app::ValidateJob(file);
-    if (std::optional<ImuErrorModel> model = app::ToImuErrorModel(file.job)) {
-      sensor = SensorRun{*std::move(model), options.seed.value_or(app::JobSeed(file.job)),
-                         options.run_index};
+    app::MonteCarloOverrides overrides;
+    overrides.seed = options.seed;
+    spec = app::ToMonteCarloSpec(file, overrides);
+    if (options.run_index >= spec.runs) {
+      throw SpecError("--run", std::to_string(options.run_index),
+                      "< monte_carlo.runs = " + std::to_string(spec.runs) +
+                          " (run N of the job's Monte Carlo)");
     }
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
@@ -88,12 +125,18 @@ int RunSimulate(const SimulateOptions& options) {
     return kExitFailure;
   }
   try {
-    const SensorRun* run = sensor ? &*sensor : nullptr;
-    SimulationCsvWriters writers(dir, /*ideal_imu=*/run != nullptr);
-    const SimulationSummary summary =
-        RunSimulation(spec, run, [&writers](const SimulationStep& step) { writers.Write(step); });
+    const bool ekf = spec.filter == NavigationFilterKind::kInsGnssEkf;
+    SimulationCsvWriters writers(dir, /*ideal_imu=*/spec.sensor.has_value());
+    std::optional<FilterCsvWriter> filter_csv;
+    if (ekf) filter_csv.emplace(dir / "filter.csv");
+    const SimulationSummary summary = SimulateMonteCarloRun(
+        spec, options.run_index, [&](const SimulationStep& step, const InsGnssFilter* filter) {
+          writers.Write(step);
+          if (filter_csv && filter != nullptr) filter_csv->Write(step.truth->t_s, *filter);
+        });
     writers.Close();
-    PrintSummary(file, spec, run, summary, dir);
+    if (filter_csv) filter_csv->Close();
+    PrintSummary(file, spec, options.run_index, summary, dir, ekf);
   } catch (const SpecError& e) {
     // The engine may still reject a job after planning (a check made while integrating).
     fmt::print(stderr, "error: {}\n", e.what());
@@ -109,14 +152,16 @@ const RegisterCommand kSimulate("simulate", [](CLI::App& app) -> std::function<i
   auto options = std::make_shared<SimulateOptions>();
   CLI::App* command = app.add_subcommand(
       "simulate",
-      "Run a job's motion through its mechanization (one seeded run of its sensor model, or "
-      "error-free IMU data without one); write truth.csv, imu.csv, nav.csv, errors.csv");
+      "Run N of the job's Monte Carlo sample by sample, exactly as `run` computes it (sensor "
+      "errors, initial errors, alignment, aiding, filter); write truth.csv, imu.csv, nav.csv, "
+      "errors.csv (and filter.csv for the INS/GNSS EKF)");
   command->add_option("job", options->job_path, "Job file (.json, .yaml, .yml)")->required();
   command->add_option("--out,-o", options->out_dir, "Output directory (created if absent)")
       ->capture_default_str();
   AddUnsignedOption(command, "--seed", &options->seed,
                     "Random seed (default: the job's monte_carlo.seed)");
-  AddUnsignedOption(command, "--run", &options->run_index, "Run index of the sensor errors")
+  AddUnsignedOption(command, "--run", &options->run_index,
+                    "Run index N (< monte_carlo.runs) of the job's Monte Carlo")
       ->capture_default_str();
   return [options] { return RunSimulate(*options); };
 });

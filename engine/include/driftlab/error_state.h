@@ -89,6 +89,17 @@ struct ScaleMisalignmentModel {
   double misalignment_sigma_rad = 0.0;  // [rad]
 };
 
+// One aiding sensor's own error states (e.g. the GNSS position Gauss-Markov error, the barometer
+// bias): sigma.size() scalar states, each a first-order Gauss-Markov process x' = -x / tau + w with
+// PSD 2 sigma^2 / tau started in its stationary distribution N(0, sigma^2) (Maybeck vol. 1,
+// 4.11), or with tau_s = 0 a random constant x ~ N(0, sigma^2). A sigma of 0 is a state that stays
+// exactly known (0).
+struct AidingErrorStates {
+  std::string owner;          // the aid's field path ("aiding.gnss")
+  std::vector<double> sigma;  // per state [the aid's unit]
+  double tau_s = 0.0;         // correlation time [s]; 0 = random constant
+};
+
 // Noise model of the error model. Units: gyro u = rad/s, accelerometer u = m/s^2.
 struct ErrorStateNoise {
   double gyro_white_psd = 0.0;   // N_g^2 [rad^2/s] (angle random walk squared)
@@ -101,12 +112,9 @@ struct ErrorStateNoise {
   // Augmented scale factor / misalignment (a sigma of 0 adds no state).
   ScaleMisalignmentModel gyro_scale_misalignment;
   ScaleMisalignmentModel accel_scale_misalignment;
-  // Aiding errors as states: GNSS position Gauss-Markov error (gnss.h, stationary start) and the
-  // barometer's Gauss-Markov bias (aiding.h, stationary start). sigma 0 = no state.
-  Vector3d gnss_position_gm_sigma_ned_m = Vector3d::Zero();
-  double gnss_position_gm_tau_s = 0.0;
-  double barometer_bias_sigma_m = 0.0;
-  double barometer_bias_tau_s = 0.0;
+  // The aiding sensors' own error states (aiding.h AidingSensor::ErrorStates), in the order of
+  // the job's aids: GNSS position Gauss-Markov error, barometer bias, odometer scale factor, ...
+  std::vector<AidingErrorStates> aiding_states;
 };
 
 // Index of every augmented block in the error state of a noise model (-1 = absent).
@@ -117,8 +125,9 @@ struct ErrorStateLayout {
   std::vector<int> gyro_bias_extra;
   int gyro_scale = -1, gyro_misalignment = -1;    // 3 and 6 states
   int accel_scale = -1, accel_misalignment = -1;  // 3 and 6 states
-  int gnss_position = -1;                         // 3 states, NED [m]
-  int barometer_bias = -1;                        // 1 state [m]
+  std::vector<int> aiding;  // first index of each ErrorStateNoise::aiding_states block
+  // First index of the block of the aid at `owner` ("aiding.gnss"), -1 if it has none.
+  int AidingFirst(const ErrorStateNoise& noise, const std::string& owner) const;
 };
 
 // Options of the conversion of an IMU error model into the error-state model.

@@ -9,8 +9,9 @@
 //   * the error covariance (error_state.h; 15 core states plus the augmented ones of the noise
 //     model) is propagated along the estimated trajectory,
 //     P <- Phi P Phi^T + Q_d, every propagation_step_samples samples (and before each update);
-//   * at a GNSS fix the innovation z = (estimated antenna position - fix) [m, NED] and
-//     (estimated antenna velocity - fix) [m/s], with
+//   * each aiding sensor's measurement (aiding.h; the model in the sensor's own file, which the
+//     covariance analysis uses too), for example at a GNSS fix the innovation z = (estimated
+//     antenna position - fix) [m, NED] and (estimated antenna velocity - fix) [m/s], with
 //       H_r = [I, 0, -[(C_b_n l_b) x], 0, 0],
 //       H_v = [0, I, -[(C_b_n (omega_ib_b x l_b)) x], 0, -C_b_n [l_b x]]     (Groves
 //       section 14.3.1)
@@ -18,10 +19,10 @@
 //     model has one (the fix corrected by its estimate e^; H = -I on x_e = e - e^; R = white^2),
 //     K = P H^T (H P H^T + R)^-1,
 //     P <- (I - K H) P (I - K H)^T + K R K^T (Joseph form);
-//   * barometer (UpdateHeight): z = (h_baro - b^) - h^ = dr_D + x_b + noise (x = estimate - truth,
+//   * barometer (barometer.cc): z = (h_baro - b^) - h^ = dr_D + x_b + noise (x = estimate - truth,
 //     dr_D = -dh; x_b = b - b^ the barometer bias state when the noise model has one),
 //     H = [0 0 1 | 0 ... | 1], R = noise^2;
-//   * zero velocity (UpdateZeroVelocity, Groves section 15.3.1): z = v^_eb_n - v_measured (0 plus
+//   * zero velocity (zupt.cc, Groves section 15.3.1): z = v^_eb_n - v_measured (0 plus
 //     the residual motion), H = [0, I, 0, 0, 0], R = sigma^2 I;
 //   * closed loop: the estimated error x = K z is removed from the navigation state at once
 //     (position and velocity subtracted, attitude C_b_n <- exp(-[psi x]) C_b_n) and added to the
@@ -59,15 +60,14 @@ class InsGnssFilter {
                 double imu_rate_hz, const InsGnssFilterOptions& options);
   // One IMU interval with the measured increment. No allocation.
   void Predict(const ImuIncrement& measured);
-  // GNSS update with a fix taken at the current time; omega_ib_b is the measured body rate (for
-  // the lever-arm velocity).
+  // The update of an aiding sensor (aiding.h) at the current time with its last measurement:
+  // its innovation and model (AidingRun::Innovation) at the filter's estimate, omega_ib_b the
+  // measured body rate (corrected here by the estimated gyro errors), first_state the index of the
+  // aid's own error states (-1: none; AidingRuns::first_state).
+  void Update(const AidingRun& aid, const Vector3d& omega_ib_b, int first_state);
+  // GNSS update with a fix taken at the current time (the GNSS model of options().gnss, gnss.cc
+  // GnssUpdate); omega_ib_b is the measured body rate (for the lever-arm velocity).
   void Update(const GnssMeasurement& fix, const Vector3d& omega_ib_b);
-  // Barometric height h_m [m] with its white-noise 1-sigma sigma_m at the current time (the bias
-  // is a state when the noise model has one; otherwise sigma_m should hold the bias too).
-  void UpdateHeight(double h_m, double sigma_m);
-  // Zero-velocity measurement v_measured_n (0 plus the standing vehicle's residual motion) with
-  // 1-sigma sigma_m_per_s per axis at the current time.
-  void UpdateZeroVelocity(double sigma_m_per_s, const Vector3d& v_measured_n = Vector3d::Zero());
   // Propagates P over the samples since the last propagation (so that P is at state().t_s).
   void SyncCovariance();
 
@@ -77,15 +77,18 @@ class InsGnssFilter {
   const Vector3d& gyro_bias() const { return gyro_bias_; }    // b^_g [rad/s], all components
   const ErrorStateLayout& layout() const { return propagator_.layout(); }
   const InsGnssFilterOptions& options() const { return options_; }
-  // Normalised innovation squared z^T S^-1 z of the last update and its dimension (3 or 6).
+  // Normalised innovation squared z^T S^-1 z of the last update and its dimension (1 to 6).
   double last_nis() const { return last_nis_; }
   int last_measurement_dim() const { return last_dim_; }
 
  private:
   // Kalman update with innovation z (estimate minus measurement), then the closed-loop correction.
+  void Correct(const AidingUpdate& update);
   template <int M>
   void Correct(const Eigen::Matrix<double, M, Eigen::Dynamic>& H,
                const Eigen::Matrix<double, M, M>& R, const Eigen::Matrix<double, M, 1>& z);
+  // The estimate an aid's model sees (omega_ib_b measured).
+  AidingEstimate Estimate(const Vector3d& omega_ib_b, int first_state) const;
   // Sums the bias estimates and builds I - S^ - M^ from sensor_estimate_.
   void RefreshCorrections();
 
@@ -102,43 +105,30 @@ class InsGnssFilter {
   // and 1 / tau of each (0 for constants and random walks).
   Eigen::VectorXd sensor_estimate_;
   Eigen::VectorXd inverse_tau_;
-  Vector3d f_n_sum_ = Vector3d::Zero();  // sum of C_b_n delta_v since the last propagation
+  Vector3d f_n_sum_ = Vector3d::Zero();    // sum of C_b_n delta_v since the last propagation
   Vector3d theta_sum_ = Vector3d::Zero();  // sum of corrected delta_theta since then
-  int64_t pending_ = 0;                  // samples since the last propagation
+  int64_t pending_ = 0;                    // samples since the last propagation
   double last_nis_ = 0.0;
   int last_dim_ = 0;
 };
-
-// The GNSS measurement model of the filter at state s with the (bias-corrected) body rate
-// omega_ib_b: H (rows 0-2 position, 3-5 velocity; the first `dim` rows used), R, and the lever
-// arm's position C_b_n l_b and velocity C_b_n (omega_ib_b x l_b) - omega_ie_n x C_b_n l_b in n.
-// With the noise model's layout: the GNSS Gauss-Markov error state (if any) gets H = -I and R the
-// white part only; without such a state R holds white^2 + Gauss-Markov^2.
-struct GnssUpdateModel {
-  Eigen::Matrix<double, 6, Eigen::Dynamic> H;
-  Eigen::Matrix<double, 6, 6> R = Eigen::Matrix<double, 6, 6>::Zero();
-  Vector3d lever_n = Vector3d::Zero();
-  Vector3d lever_velocity_n = Vector3d::Zero();
-  int dim = 3;
-};
-GnssUpdateModel MakeGnssUpdateModel(const NavEnvironment& env, const GnssConfig& gnss,
-                                    const NavState& s, const Vector3d& omega_ib_b,
-                                    const ErrorStateLayout& layout);
 
 // Linear covariance analysis of the filter (or of the free INS) along the truth trajectory of
 // `motion` at rate_hz, streamed (memory O(step_samples)): P0 at t = 0, propagated as the filter
 // does (every step_samples samples, and at every epoch and update sample; F at the truth state at
 // the end of the interval with its mean specific force), and at each sample after recording an
-// epoch, updated in Joseph form by the aids the filter uses, in the filter's order: GNSS (at its
-// epochs outside the outages, H with the truth attitude and the ideal body rate), barometer,
-// ZUPT (at zupt_epochs). aiding = nullptr: free inertial. epoch_samples ascending in [0, n].
+// epoch, updated in Joseph form by the aids the schedule has due there, in its order (each aid's
+// AidingSensor::Model at the truth state with the ideal body rate: the filter's H and R).
+// schedule = nullptr: free inertial. epoch_samples ascending in [0, n]; `noise` holds the aids'
+// own error states (AidingSensor::ErrorStates) as the filter's does.
 // The gain is the one a filter running on the truth would use; for a consistent filter the
 // predicted sigma is the Monte-Carlo spread (Maybeck vol. 1, section 6.8; Gelb, "Applied Optimal
 // Estimation", section 7.1, covariance analysis).
-std::vector<CovarianceEpoch> FilterCovarianceAnalysis(
-    const MotionSpec& motion, double rate_hz, const ErrorStateNoise& noise,
-    const ErrorStateMatrix& P0, const AidingSpec* aiding, const std::vector<int64_t>& zupt_epochs,
-    const std::vector<int64_t>& epoch_samples, int64_t step_samples, Discretization method);
+std::vector<CovarianceEpoch> FilterCovarianceAnalysis(const MotionSpec& motion, double rate_hz,
+                                                      const ErrorStateNoise& noise,
+                                                      const ErrorStateMatrix& P0,
+                                                      const AidingSchedule* schedule,
+                                                      const std::vector<int64_t>& epoch_samples,
+                                                      int64_t step_samples, Discretization method);
 
 // The normalised estimation error squared e^T P^-1 e (NEES) of an error state.
 double Nees(const ErrorStateVector& error, const ErrorStateMatrix& P);

@@ -111,7 +111,8 @@ class GrovesProfileWriter : public CsvFile {
 // The files of `driftlab simulate` / `export` in `dir`: truth.csv, imu.csv (what the IMU outputs:
 // the measured data when the step has them, else the ideal data), nav.csv, errors.csv and, with
 // `ideal_imu`, imu_ideal.csv (the error-free data); one row per output epoch (k = 0 carries the
-// zero increment).
+// zero increment; nav.csv and errors.csv from the navigation start on, when the step has a
+// solution).
 class SimulationCsvWriters {
  public:
   explicit SimulationCsvWriters(const std::filesystem::path& dir, bool ideal_imu = false);

@@ -24,6 +24,7 @@
 #include "driftlab/complementary_filter.h"
 #include "driftlab/covariance.h"
 #include "driftlab/exact_sum.h"
+#include "driftlab/ins_gnss_filter.h"
 #include "driftlab/mc_statistics.h"
 #include "driftlab/sensor_params.h"
 #include "driftlab/simulate.h"
@@ -229,35 +230,59 @@ struct MonteCarloRunLayout {
 struct MonteCarloRunStep {
   int64_t k = 0;
   const NavState* truth = nullptr;  // truth at t_k
+  // The ideal IMU data: the increment over (t_{k-1}, t_k] (zero at k = 0) and the point sample.
+  const ImuIncrement* increment = nullptr;
+  const ImuSample* sample = nullptr;
   // The run's measured IMU data: the increment over (t_{k-1}, t_k] (zero at k = 0) and the point
-  // sample at t_k, each from its own ImuErrorSimulator of (model, seed, run, rate) exactly as
-  // RunSimulation (simulate.h) makes them, so they equal `driftlab export --seed S --run R`.
+  // sample at t_k, each from its own ImuErrorSimulator of (model, seed, run, rate); the stream the
+  // run's navigator reads (increments for mechanization A and the EKF, point samples for
+  // mechanization B and the complementary filter) is the one it navigated with.
   const ImuIncrement* measured_increment = nullptr;
   const ImuSample* measured_sample = nullptr;
-  // The run's navigation solution at t_k (the solution RunMonteCarlo scores), from s0 on and only
-  // when navigation was asked for; nullptr otherwise.
+  // The run's navigation solution at t_k (the solution RunMonteCarlo scores: after the step at k,
+  // before the aiding updates at k), from s0 on and only when navigation was asked for; nullptr
+  // otherwise.
   const NavState* nav = nullptr;
+  // The run's INS/GNSS EKF at t_k (its estimates and covariance; the covariance is propagated to
+  // t_k at the output epochs and at aiding updates, between them it is the last propagated one),
+  // for a kInsGnssEkf job when navigation was asked for; nullptr otherwise.
+  const InsGnssFilter* filter = nullptr;
   // Index of the output epoch / checkpoint at sample k, or -1; report_t_s = k dt_s as the
   // statistics report it (MonteCarloStatisticsData::epoch_times_s, CheckpointValues::t_s).
   int epoch = -1;
   int checkpoint = -1;
   double report_t_s = 0.0;
+  // At a checkpoint: the run's error components exactly as RunMonteCarlo keeps them
+  // (CheckpointValues::values of this run); nullptr elsewhere.
+  const ErrorComponentValues* checkpoint_values = nullptr;
 };
 
-// Replays run `run` of the job sample by sample exactly as RunMonteCarlo computes it: the same
-// truth, the run's sensor errors from RandomStream(seed, run, ...), its initial errors, alignment
-// and mechanization (spec.first_run / run_count are ignored; run < spec.runs is required). For
-// users who bring their own navigation algorithm (the gRPC Datasets service): the errors of the
-// steps' `nav` against their `truth` at the epochs are the numbers RunMonteCarlo accumulates for
-// this run. Validation as RunMonteCarlo (SpecError; "monte_carlo.first_run" for run >= runs;
-// "navigation.filter" when navigate is asked for a job with a filter: the replay navigates with
-// the free-inertial mechanization only).
+// Replays run `run` of the job sample by sample exactly as RunMonteCarlo computes it: the
+// Monte Carlo's own run (the same truth, the run's sensor errors from RandomStream(seed, run, ...),
+// its initial errors, alignment, aiding measurements, filter and mechanization) with an observer
+// at every sample (spec.first_run / run_count are ignored; run < spec.runs is required). For
+// `driftlab simulate --run N`, `driftlab export --run N` and users who bring their own navigation
+// algorithm (the gRPC Datasets service): the errors of the steps' `nav` against their `truth` at
+// the epochs are the numbers RunMonteCarlo accumulates for this run, and checkpoint_values are
+// its kept values bit for bit. Validation as RunMonteCarlo (SpecError; "monte_carlo.first_run"
+// for run >= runs). The free-inertial mechanization A runs through the scalar run (the lockstep
+// runs are tested equal to it bit for bit). Memory O(samples) (the run's ideal IMU data);
 // `cancel` is polled every 1024 samples; returns false when it stopped the replay, else true.
-// Memory O(epochs); not a hot path (one std::function call per sample).
+// Not a hot path (one virtual call per sample).
 bool ReplayMonteCarloRun(const MonteCarloSpec& spec, uint32_t run, bool navigate,
                          const std::function<void(const MonteCarloRunLayout&)>& on_start,
                          const std::function<void(const MonteCarloRunStep&)>& on_step,
                          const std::atomic<bool>* cancel = nullptr);
+
+// Run N of the job as a simulation (`driftlab simulate --run N`, `driftlab export --run N`):
+// ReplayMonteCarloRun with navigation, every sample k = 0..n to on_step (optional) as a
+// SimulationStep (ideal and measured IMU data, truth; nav and error from the navigation start on,
+// nullptr before it), and the summary of the errors from the navigation start on. `filter`
+// (optional) receives the run's EKF at each step (nullptr for other navigators). Throws SpecError
+// as ReplayMonteCarloRun.
+SimulationSummary SimulateMonteCarloRun(
+    const MonteCarloSpec& spec, uint32_t run,
+    const std::function<void(const SimulationStep&, const InsGnssFilter*)>& on_step);
 
 // Every check RunMonteCarlo makes before it starts, without generating the trajectory (cost
 // O(segments + epochs)): the Monte-Carlo fields, the sensor model, the navigation start, the

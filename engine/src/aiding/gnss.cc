@@ -1,7 +1,12 @@
 #include "driftlab/gnss.h"
 
 #include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <utility>
 
+#include "driftlab/aiding.h"
 #include "driftlab/attitude.h"
 #include "driftlab/elementary.h"
 #include "driftlab/spec_error.h"
@@ -17,7 +22,115 @@ void CheckSigmas(const Vector3d& s, const std::string& field) {
   }
 }
 
+bool InOutage(const GnssConfig& config, double t_s) {
+  for (const GnssOutage& o : config.outages) {
+    if (t_s >= o.start_s && t_s < o.start_s + o.duration_s) return true;
+  }
+  return false;
+}
+
+// The GNSS receiver as the EKF's aid: epochs at its rate outside the outages, its position
+// Gauss-Markov error as 3 states (when configured), GnssUpdate as its model.
+class GnssSensor : public AidingSensor {
+ public:
+  GnssSensor(const GnssConfig& config, double imu_rate_hz, std::string path)
+      : config_(config), imu_rate_hz_(imu_rate_hz), path_(std::move(path)) {
+    ValidateGnssConfig(config, imu_rate_hz, path_);
+    decimation_ = static_cast<int64_t>(std::llround(imu_rate_hz / config.rate_hz));
+  }
+  const std::string& path() const override { return path_; }
+  int64_t decimation() const override { return decimation_; }
+  bool Available(double t_s) const override { return !InOutage(config_, t_s); }
+  std::vector<AidingErrorStates> ErrorStates() const override {
+    const Vector3d& s = config_.position_gauss_markov_sigma_ned_m;
+    if (s.isZero(0.0)) return {};
+    return {AidingErrorStates{path_, {s.x(), s.y(), s.z()}, config_.position_gauss_markov_tau_s}};
+  }
+  void Model(const AidingEstimate& e, AidingUpdate* u) const override {
+    GnssUpdate(config_, e, nullptr, u);
+  }
+  std::unique_ptr<AidingRun> Start(const NavEnvironment& env, uint64_t seed,
+                                   uint32_t run) const override;
+  const GnssConfig& config() const { return config_; }
+  double imu_rate_hz() const { return imu_rate_hz_; }
+
+ private:
+  GnssConfig config_;
+  double imu_rate_hz_;
+  std::string path_;
+  int64_t decimation_ = 1;
+};
+
+class GnssRun : public AidingRun {
+ public:
+  GnssRun(const GnssSensor& sensor, const NavEnvironment& env, uint64_t seed, uint32_t run)
+      : config_(sensor.config()),
+        simulator_(sensor.config(), env, sensor.imu_rate_hz(), seed, run, sensor.path()) {}
+  bool Measure(int64_t k, const AidingTruth& truth) override {
+    return simulator_.Measure(k, truth.truth, truth.omega_ib_b, &fix_);
+  }
+  void Innovation(const AidingEstimate& e, AidingUpdate* u) const override {
+    GnssUpdate(config_, e, &fix_, u);
+  }
+
+ private:
+  GnssConfig config_;
+  GnssSimulator simulator_;
+  GnssMeasurement fix_;
+};
+
+std::unique_ptr<AidingRun> GnssSensor::Start(const NavEnvironment& env, uint64_t seed,
+                                             uint32_t run) const {
+  return std::make_unique<GnssRun>(*this, env, seed, run);
+}
+
 }  // namespace
+
+std::shared_ptr<const AidingSensor> MakeGnssSensor(const GnssConfig& config, double imu_rate_hz,
+                                                   const std::string& path) {
+  return std::make_shared<GnssSensor>(config, imu_rate_hz, path);
+}
+
+void GnssUpdate(const GnssConfig& g, const AidingEstimate& e, const GnssMeasurement* fix,
+                AidingUpdate* u) {
+  const NavState& s = *e.state;
+  const ErrorStateLayout& layout = *e.layout;
+  u->H = Eigen::Matrix<double, AidingUpdate::kMaxDim, Eigen::Dynamic>::Zero(6, layout.size);
+  const Matrix3d C = s.C_b_n();
+  const Vector3d& l = g.lever_arm_b_m;
+  const Vector3d lever_n = C * l;
+  u->dim = g.use_velocity ? 6 : 3;
+  // Position rows: H_r = [I, 0, -[(C_b_n l_b) x], 0, 0] (Groves section 14.3.1, x = est - truth).
+  u->H.block<3, 3>(0, kErrPosition) = Matrix3d::Identity();
+  u->H.block<3, 3>(0, kErrAttitude) = -Skew(lever_n);
+  const bool gm_state = e.first_state >= 0;
+  // The Gauss-Markov error state x_e = e - e^: z = est - (fix - e^) = dr - x_e - noise.
+  if (gm_state) u->H.block<3, 3>(0, e.first_state) = -Matrix3d::Identity();
+  for (int i = 0; i < 3; ++i) {
+    const double gm = gm_state ? 0.0 : g.position_gauss_markov_sigma_ned_m[i];
+    u->R(i, i) = g.position_sigma_ned_m[i] * g.position_sigma_ned_m[i] + gm * gm;
+  }
+  Vector3d lever_velocity_n = Vector3d::Zero();
+  if (u->dim == 6) {
+    // The lever arm's velocity also depends on the gyro scale factor / misalignment (|l| sigma_s
+    // omega, second order for lever arms of a metre): not modelled.
+    const Vector3d w_x_l = C * e.omega_ib_b.cross(l);
+    lever_velocity_n = w_x_l - e.env->EarthRate(s.llh.lat_rad).cross(lever_n);
+    u->H.block<3, 3>(3, kErrVelocity) = Matrix3d::Identity();
+    u->H.block<3, 3>(3, kErrAttitude) = -Skew(w_x_l);
+    u->H.block<3, 3>(3, kErrGyroBias) = -C * Skew(l);
+    for (int first : layout.gyro_bias_extra) u->H.block<3, 3>(3, first) = -C * Skew(l);
+    for (int i = 0; i < 3; ++i) {
+      u->R(3 + i, 3 + i) = g.velocity_sigma_ned_m_per_s[i] * g.velocity_sigma_ned_m_per_s[i];
+    }
+  }
+  if (fix == nullptr) return;
+  // Innovation: estimated antenna minus fix (position in metres NED at the fix), the fix
+  // corrected by the estimated Gauss-Markov error.
+  u->z.head<3>() = e.env->PositionErrorNed(s.llh, fix->llh) + lever_n;
+  if (gm_state) u->z.head<3>() += Eigen::Map<const Vector3d>(e.own_states);
+  if (u->dim == 6) u->z.tail<3>() = s.v_eb_n + lever_velocity_n - fix->v_eb_n;
+}
 
 void ValidateGnssConfig(const GnssConfig& c, double imu_rate_hz, const std::string& path) {
   if (!std::isfinite(c.rate_hz) || c.rate_hz <= 0.0 || c.rate_hz > imu_rate_hz) {
@@ -107,12 +220,7 @@ GnssSimulator::GnssSimulator(const GnssConfig& config, const NavEnvironment& env
   }
 }
 
-bool GnssSimulator::InOutage(double t_s) const {
-  for (const GnssOutage& o : config_.outages) {
-    if (t_s >= o.start_s && t_s < o.start_s + o.duration_s) return true;
-  }
-  return false;
-}
+bool GnssSimulator::InOutage(double t_s) const { return driftlab::InOutage(config_, t_s); }
 
 bool GnssSimulator::Measure(int64_t k, const NavState& truth, const Vector3d& omega_ib_b,
                             GnssMeasurement* out) {

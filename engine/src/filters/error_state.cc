@@ -123,9 +123,17 @@ ErrorStateLayout::ErrorStateLayout(const ErrorStateNoise& noise) {
     accel_scale = take(3);
     accel_misalignment = take(6);
   }
-  if (!noise.gnss_position_gm_sigma_ned_m.isZero(0.0)) gnss_position = take(3);
-  if (noise.barometer_bias_sigma_m > 0.0) barometer_bias = take(1);
+  for (const AidingErrorStates& a : noise.aiding_states) {
+    aiding.push_back(take(static_cast<int>(a.sigma.size())));
+  }
   size = next;
+}
+
+int ErrorStateLayout::AidingFirst(const ErrorStateNoise& noise, const std::string& owner) const {
+  for (size_t i = 0; i < noise.aiding_states.size() && i < aiding.size(); ++i) {
+    if (noise.aiding_states[i].owner == owner) return aiding[i];
+  }
+  return -1;
 }
 
 std::vector<BiasStateModel> FitFlickerStates(const FlickerParams& flicker, int count,
@@ -281,13 +289,14 @@ ErrorStateMatrix ErrorStateSystemMatrix(const NavEnvironment& env, const NavStat
   };
   sm_block(layout.gyro_scale, layout.gyro_misalignment, kErrAttitude, omega_ib_b);
   sm_block(layout.accel_scale, layout.accel_misalignment, kErrVelocity, f_ib_b);
-  // Aiding Gauss-Markov errors: e' = -e / tau.
-  if (layout.gnss_position >= 0) {
-    F.block<3, 3>(layout.gnss_position, layout.gnss_position) =
-        -Matrix3d::Identity() / noise.gnss_position_gm_tau_s;
-  }
-  if (layout.barometer_bias >= 0) {
-    F(layout.barometer_bias, layout.barometer_bias) = -1.0 / noise.barometer_bias_tau_s;
+  // Aiding errors: e' = -e / tau (Gauss-Markov) or 0 (random constants).
+  for (size_t b = 0; b < noise.aiding_states.size(); ++b) {
+    const AidingErrorStates& a = noise.aiding_states[b];
+    if (!(a.tau_s > 0.0)) continue;
+    for (size_t i = 0; i < a.sigma.size(); ++i) {
+      const int j = layout.aiding[b] + static_cast<int>(i);
+      F(j, j) = -1.0 / a.tau_s;
+    }
   }
   return F;
 }
@@ -308,17 +317,16 @@ ErrorStateMatrix ErrorStateProcessNoise(const ErrorStateNoise& noise) {
   for (size_t i = 0; i < layout.gyro_bias_extra.size(); ++i) {
     diag3(layout.gyro_bias_extra[i], noise.gyro_bias_extra[i].driving_psd);
   }
-  // Gauss-Markov aiding errors: PSD 2 sigma^2 / tau (stationary variance sigma^2).
-  if (layout.gnss_position >= 0) {
-    for (int i = 0; i < 3; ++i) {
-      const double s = noise.gnss_position_gm_sigma_ned_m[i];
-      Q(layout.gnss_position + i, layout.gnss_position + i) =
-          2.0 * s * s / noise.gnss_position_gm_tau_s;
+  // Gauss-Markov aiding errors: PSD 2 sigma^2 / tau (stationary variance sigma^2); random
+  // constants none.
+  for (size_t b = 0; b < noise.aiding_states.size(); ++b) {
+    const AidingErrorStates& a = noise.aiding_states[b];
+    if (!(a.tau_s > 0.0)) continue;
+    for (size_t i = 0; i < a.sigma.size(); ++i) {
+      const int j = layout.aiding[b] + static_cast<int>(i);
+      const double s = a.sigma[i];
+      Q(j, j) = 2.0 * s * s / a.tau_s;
     }
-  }
-  if (layout.barometer_bias >= 0) {
-    const double s = noise.barometer_bias_sigma_m;
-    Q(layout.barometer_bias, layout.barometer_bias) = 2.0 * s * s / noise.barometer_bias_tau_s;
   }
   return Q;
 }
@@ -382,12 +390,12 @@ ErrorStateMatrix InitialErrorCovariance(const Vector3d& position_sigma_ned_m,
     diag(layout.accel_scale, 3, noise.accel_scale_misalignment.scale_factor_sigma);
     diag(layout.accel_misalignment, 6, noise.accel_scale_misalignment.misalignment_sigma_rad);
   }
-  if (layout.gnss_position >= 0) {
-    for (int i = 0; i < 3; ++i) {
-      diag(layout.gnss_position + i, 1, noise.gnss_position_gm_sigma_ned_m[i]);
+  for (size_t b = 0; b < noise.aiding_states.size(); ++b) {
+    const AidingErrorStates& a = noise.aiding_states[b];
+    for (size_t i = 0; i < a.sigma.size(); ++i) {
+      diag(layout.aiding[b] + static_cast<int>(i), 1, a.sigma[i]);
     }
   }
-  if (layout.barometer_bias >= 0) diag(layout.barometer_bias, 1, noise.barometer_bias_sigma_m);
   return P;
 }
 

@@ -49,8 +49,10 @@ InsGnssFilter::InsGnssFilter(const NavEnvironment& env, const NavState& initial,
   for (size_t i = 0; i < layout.gyro_bias_extra.size(); ++i) {
     set_tau(layout.gyro_bias_extra[i], 3, noise.gyro_bias_extra[i].tau_s);
   }
-  set_tau(layout.gnss_position, 3, noise.gnss_position_gm_tau_s);
-  set_tau(layout.barometer_bias, 1, noise.barometer_bias_tau_s);
+  for (size_t b = 0; b < noise.aiding_states.size(); ++b) {
+    set_tau(layout.aiding[b], static_cast<int>(noise.aiding_states[b].sigma.size()),
+            noise.aiding_states[b].tau_s);
+  }
 }
 
 void InsGnssFilter::RefreshCorrections() {
@@ -106,41 +108,6 @@ void InsGnssFilter::SyncCovariance() {
   pending_ = 0;
 }
 
-GnssUpdateModel MakeGnssUpdateModel(const NavEnvironment& env, const GnssConfig& g,
-                                    const NavState& s, const Vector3d& omega_ib_b,
-                                    const ErrorStateLayout& layout) {
-  GnssUpdateModel m;
-  m.H = Eigen::Matrix<double, 6, Eigen::Dynamic>::Zero(6, layout.size);
-  const Matrix3d C = s.C_b_n();
-  const Vector3d& l = g.lever_arm_b_m;
-  m.lever_n = C * l;
-  m.dim = g.use_velocity ? 6 : 3;
-  // Position rows: H_r = [I, 0, -[(C_b_n l_b) x], 0, 0] (Groves section 14.3.1, x = est - truth).
-  m.H.block<3, 3>(0, kErrPosition) = Matrix3d::Identity();
-  m.H.block<3, 3>(0, kErrAttitude) = -Skew(m.lever_n);
-  const bool gm_state = layout.gnss_position >= 0;
-  // The Gauss-Markov error state x_e = e - e^: z = est - (fix - e^) = dr - x_e - noise.
-  if (gm_state) m.H.block<3, 3>(0, layout.gnss_position) = -Matrix3d::Identity();
-  for (int i = 0; i < 3; ++i) {
-    const double gm = gm_state ? 0.0 : g.position_gauss_markov_sigma_ned_m[i];
-    m.R(i, i) = g.position_sigma_ned_m[i] * g.position_sigma_ned_m[i] + gm * gm;
-  }
-  if (m.dim == 6) {
-    // The lever arm's velocity also depends on the gyro scale factor / misalignment (|l| sigma_s
-    // omega, second order for lever arms of a metre): not modelled.
-    const Vector3d w_x_l = C * omega_ib_b.cross(l);
-    m.lever_velocity_n = w_x_l - env.EarthRate(s.llh.lat_rad).cross(m.lever_n);
-    m.H.block<3, 3>(3, kErrVelocity) = Matrix3d::Identity();
-    m.H.block<3, 3>(3, kErrAttitude) = -Skew(w_x_l);
-    m.H.block<3, 3>(3, kErrGyroBias) = -C * Skew(l);
-    for (int first : layout.gyro_bias_extra) m.H.block<3, 3>(3, first) = -C * Skew(l);
-    for (int i = 0; i < 3; ++i) {
-      m.R(3 + i, 3 + i) = g.velocity_sigma_ned_m_per_s[i] * g.velocity_sigma_ned_m_per_s[i];
-    }
-  }
-  return m;
-}
-
 template <int M>
 void InsGnssFilter::Correct(const Eigen::Matrix<double, M, Eigen::Dynamic>& H,
                             const Eigen::Matrix<double, M, M>& R,
@@ -168,61 +135,61 @@ void InsGnssFilter::Correct(const Eigen::Matrix<double, M, Eigen::Dynamic>& H,
   ins_ = NedMechanization(env_, c, dt_s_, options_.mechanization);
 }
 
+void InsGnssFilter::Correct(const AidingUpdate& u) {
+  switch (u.dim) {
+    case 1:
+      Correct<1>(u.H.topRows<1>(), u.R.topLeftCorner<1, 1>(), u.z.head<1>());
+      return;
+    case 2:
+      Correct<2>(u.H.topRows<2>(), u.R.topLeftCorner<2, 2>(), u.z.head<2>());
+      return;
+    case 3:
+      Correct<3>(u.H.topRows<3>(), u.R.topLeftCorner<3, 3>(), u.z.head<3>());
+      return;
+    case 6:
+      Correct<6>(u.H, u.R, u.z);
+      return;
+    default:
+      throw SpecError("aiding", std::to_string(u.dim) + " measurement rows", "1, 2, 3 or 6");
+  }
+}
+
+AidingEstimate InsGnssFilter::Estimate(const Vector3d& omega_ib_b, int first_state) const {
+  AidingEstimate e;
+  e.env = &env_;
+  e.state = &ins_.state();
+  e.omega_ib_b = gyro_correction_ * (omega_ib_b - gyro_bias_);
+  e.layout = &propagator_.layout();
+  e.first_state = first_state;
+  if (first_state >= 0) e.own_states = sensor_estimate_.data() + (first_state - kNumNavErrorStates);
+  return e;
+}
+
+void InsGnssFilter::Update(const AidingRun& aid, const Vector3d& omega_ib_b, int first_state) {
+  SyncCovariance();
+  AidingUpdate u;
+  aid.Innovation(Estimate(omega_ib_b, first_state), &u);
+  Correct(u);
+}
+
 void InsGnssFilter::Update(const GnssMeasurement& fix, const Vector3d& omega_ib_b) {
   SyncCovariance();
-  const NavState& s = ins_.state();
   const ErrorStateLayout& layout = propagator_.layout();
-  const GnssUpdateModel m = MakeGnssUpdateModel(
-      env_, options_.gnss, s, gyro_correction_ * (omega_ib_b - gyro_bias_), layout);
-  // Innovation: estimated antenna minus fix (position in metres NED at the fix), the fix
-  // corrected by the estimated Gauss-Markov error.
-  Eigen::Matrix<double, 6, 1> z;
-  z.head<3>() = env_.PositionErrorNed(s.llh, fix.llh) + m.lever_n;
-  if (layout.gnss_position >= 0) {
-    z.head<3>() += sensor_estimate_.segment<3>(layout.gnss_position - kNumNavErrorStates);
+  int first_state = -1;
+  for (size_t b = 0; b < options_.imu_noise.aiding_states.size(); ++b) {
+    if (options_.imu_noise.aiding_states[b].owner == "aiding.gnss") first_state = layout.aiding[b];
   }
-  if (m.dim == 6) {
-    z.tail<3>() = s.v_eb_n + m.lever_velocity_n - fix.v_eb_n;
-    Correct<6>(m.H, m.R, z);
-  } else {
-    const Eigen::Matrix<double, 3, Eigen::Dynamic> H3 = m.H.topRows<3>();
-    const Eigen::Matrix3d R3 = m.R.topLeftCorner<3, 3>();
-    const Eigen::Vector3d z3 = z.head<3>();
-    Correct<3>(H3, R3, z3);
-  }
+  AidingUpdate u;
+  GnssUpdate(options_.gnss, Estimate(omega_ib_b, first_state), &fix, &u);
+  Correct(u);
 }
 
-void InsGnssFilter::UpdateHeight(double h_m, double sigma_m) {
-  SyncCovariance();
-  const ErrorStateLayout& layout = propagator_.layout();
-  Eigen::Matrix<double, 1, Eigen::Dynamic> H =
-      Eigen::Matrix<double, 1, Eigen::Dynamic>::Zero(1, layout.size);
-  H(0, kErrPosition + 2) = 1.0;
-  double bias_estimate_m = 0.0;
-  if (layout.barometer_bias >= 0) {
-    H(0, layout.barometer_bias) = 1.0;
-    bias_estimate_m = sensor_estimate_[layout.barometer_bias - kNumNavErrorStates];
-  }
-  // z = (estimated down) - (measured down) = (h_baro - b^) - h^ = dr_D + x_b + noise.
-  const Eigen::Matrix<double, 1, 1> z(h_m - bias_estimate_m - ins_.state().llh.h_m);
-  const Eigen::Matrix<double, 1, 1> R(sigma_m * sigma_m);
-  Correct<1>(H, R, z);
-}
-
-void InsGnssFilter::UpdateZeroVelocity(double sigma_m_per_s, const Vector3d& v_measured_n) {
-  SyncCovariance();
-  Eigen::Matrix<double, 3, Eigen::Dynamic> H =
-      Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, propagator_.layout().size);
-  H.block<3, 3>(0, kErrVelocity) = Matrix3d::Identity();
-  const Eigen::Matrix3d R = Matrix3d::Identity() * (sigma_m_per_s * sigma_m_per_s);
-  const Eigen::Vector3d z = ins_.state().v_eb_n - v_measured_n;
-  Correct<3>(H, R, z);
-}
-
-std::vector<CovarianceEpoch> FilterCovarianceAnalysis(
-    const MotionSpec& motion, double rate_hz, const ErrorStateNoise& noise,
-    const ErrorStateMatrix& P0, const AidingSpec* aiding, const std::vector<int64_t>& zupt_epochs,
-    const std::vector<int64_t>& epoch_samples, int64_t step_samples, Discretization method) {
+std::vector<CovarianceEpoch> FilterCovarianceAnalysis(const MotionSpec& motion, double rate_hz,
+                                                      const ErrorStateNoise& noise,
+                                                      const ErrorStateMatrix& P0,
+                                                      const AidingSchedule* schedule,
+                                                      const std::vector<int64_t>& epoch_samples,
+                                                      int64_t step_samples, Discretization method) {
   if (step_samples < 1 || step_samples > 10000) {
     throw SpecError("monte_carlo.covariance_step_samples", std::to_string(step_samples),
                     "[1, 10000]");
@@ -231,40 +198,17 @@ std::vector<CovarianceEpoch> FilterCovarianceAnalysis(
   const NavEnvironment& env = generator.environment();
   const double dt = generator.dt_s();
   ErrorCovariancePropagator prop(env, noise, P0, method);
-  const GnssConfig* gnss = aiding != nullptr && aiding->gnss ? &*aiding->gnss : nullptr;
-  const BarometerConfig* baro =
-      aiding != nullptr && aiding->barometer ? &*aiding->barometer : nullptr;
-  const ZuptConfig* zupt = aiding != nullptr && aiding->zupt ? &*aiding->zupt : nullptr;
-  const int64_t gnss_dec =
-      gnss ? AidingDecimation(gnss->rate_hz, rate_hz, "aiding.gnss.rate_hz") : 0;
-  const int64_t baro_dec =
-      baro ? AidingDecimation(baro->rate_hz, rate_hz, "aiding.barometer.rate_hz") : 0;
   const ErrorStateLayout& layout = prop.layout();
-  Eigen::Matrix<double, 1, Eigen::Dynamic> H_baro =
-      Eigen::Matrix<double, 1, Eigen::Dynamic>::Zero(1, layout.size);
-  H_baro(0, kErrPosition + 2) = 1.0;
-  if (layout.barometer_bias >= 0) H_baro(0, layout.barometer_bias) = 1.0;
-  Eigen::Matrix<double, 1, 1> R_baro = Eigen::Matrix<double, 1, 1>::Zero();
-  if (baro) {
-    // As the Monte-Carlo runs call UpdateHeight: the bias in R only when it is not a state.
-    const double bias_sigma = layout.barometer_bias >= 0 ? 0.0 : baro->bias.sigma;
-    R_baro(0, 0) = baro->noise_sigma_m * baro->noise_sigma_m + bias_sigma * bias_sigma;
-  }
-  Eigen::Matrix<double, 3, Eigen::Dynamic> H_zupt =
-      Eigen::Matrix<double, 3, Eigen::Dynamic>::Zero(3, layout.size);
-  H_zupt.block<3, 3>(0, kErrVelocity) = Matrix3d::Identity();
-  const double zupt_var = zupt ? zupt->velocity_sigma_m_per_s * zupt->velocity_sigma_m_per_s : 0.0;
-  const Eigen::Matrix3d R_zupt = Matrix3d::Identity() * zupt_var;
-  auto in_outage = [gnss](double t_s) {
-    for (const GnssOutage& o : gnss->outages) {
-      if (t_s >= o.start_s && t_s < o.start_s + o.duration_s) return true;
+  std::vector<int> first_state;
+  if (schedule != nullptr) {
+    for (const auto& sensor : schedule->sensors()) {
+      first_state.push_back(layout.AidingFirst(noise, sensor->path()));
     }
-    return false;
-  };
+  }
 
   std::vector<CovarianceEpoch> out;
   out.reserve(epoch_samples.size());
-  size_t next_epoch = 0, next_zupt = 0;
+  size_t next_epoch = 0;
   const NavState& truth0 = generator.initial_state();
   if (next_epoch < epoch_samples.size() && epoch_samples[next_epoch] == 0) {
     out.push_back(MakeCovarianceEpoch(truth0.t_s, prop.P(), truth0.euler()));
@@ -284,11 +228,8 @@ std::vector<CovarianceEpoch> FilterCovarianceAnalysis(
     C_prev = C;
     ++pending;
     const bool epoch = next_epoch < epoch_samples.size() && epoch_samples[next_epoch] == k;
-    while (next_zupt < zupt_epochs.size() && zupt_epochs[next_zupt] < k) ++next_zupt;
-    const bool gnss_now = gnss && k % gnss_dec == 0 && !in_outage(truth.t_s);
-    const bool baro_now = baro && k % baro_dec == 0;
-    const bool zupt_now = zupt && next_zupt < zupt_epochs.size() && zupt_epochs[next_zupt] == k;
-    if (pending >= step_samples || epoch || gnss_now || baro_now || zupt_now) {
+    const uint32_t due = schedule != nullptr ? schedule->Due(k, truth.t_s) : 0;
+    if (pending >= step_samples || epoch || due != 0) {
       // As InsGnssFilter::SyncCovariance: F at the state at the end of the interval with the
       // interval's mean specific force resolved in its body frame.
       const double T = static_cast<double>(pending) * dt;
@@ -301,19 +242,34 @@ std::vector<CovarianceEpoch> FilterCovarianceAnalysis(
       out.push_back(MakeCovarianceEpoch(truth.t_s, prop.P(), truth.euler()));
       ++next_epoch;
     }
-    if (gnss_now) {
-      const Vector3d omega_ib_b = sample.increment.delta_theta_ib_b / dt;
-      const GnssUpdateModel m = MakeGnssUpdateModel(env, *gnss, truth, omega_ib_b, layout);
-      if (m.dim == 6) {
-        JosephUpdate<6>(m.H, m.R, &prop.mutable_P());
-      } else {
-        const Eigen::Matrix<double, 3, Eigen::Dynamic> H3 = m.H.topRows<3>();
-        const Eigen::Matrix3d R3 = m.R.topLeftCorner<3, 3>();
-        JosephUpdate<3>(H3, R3, &prop.mutable_P());
+    for (size_t i = 0; due != 0 && i < first_state.size(); ++i) {
+      if ((due >> i & 1u) == 0) continue;
+      AidingEstimate e;
+      e.env = &env;
+      e.state = &truth;
+      e.omega_ib_b = sample.increment.delta_theta_ib_b / dt;
+      e.layout = &layout;
+      e.first_state = first_state[i];
+      AidingUpdate u;
+      schedule->sensors()[i]->Model(e, &u);
+      switch (u.dim) {
+        case 1:
+          JosephUpdate<1>(u.H.topRows<1>(), u.R.topLeftCorner<1, 1>(), &prop.mutable_P());
+          break;
+        case 2:
+          JosephUpdate<2>(u.H.topRows<2>(), u.R.topLeftCorner<2, 2>(), &prop.mutable_P());
+          break;
+        case 3:
+          JosephUpdate<3>(u.H.topRows<3>(), u.R.topLeftCorner<3, 3>(), &prop.mutable_P());
+          break;
+        case 6:
+          JosephUpdate<6>(u.H, u.R, &prop.mutable_P());
+          break;
+        default:
+          throw SpecError(schedule->sensors()[i]->path(), std::to_string(u.dim) + " rows",
+                          "1, 2, 3 or 6 measurement rows");
       }
     }
-    if (baro_now) JosephUpdate<1>(H_baro, R_baro, &prop.mutable_P());
-    if (zupt_now) JosephUpdate<3>(H_zupt, R_zupt, &prop.mutable_P());
   }
   return out;
 }

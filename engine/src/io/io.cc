@@ -386,6 +386,8 @@ void SimulationCsvWriters::Write(const SimulationStep& step) {
   imu_.Write(t_s, measured ? *step.measured_increment : *step.increment,
              measured ? *step.measured_sample : *step.sample);
   if (imu_ideal_) imu_ideal_->Write(t_s, *step.increment, *step.sample);
+  // Before the navigation start (an alignment window) there is no solution.
+  if (step.nav == nullptr) return;
   nav_.Write(*step.nav);
   errors_.Write(t_s, *step.error);
 }

@@ -15,11 +15,14 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "driftlab/aiding.h"
 #include "driftlab/error_state.h"
+#include "driftlab/ins_gnss_filter.h"
 #include "driftlab/monte_carlo.h"
 #include "montecarlo/run_loop.h"
 
@@ -63,14 +66,18 @@ struct SharedTruth {
   // Truth-height aiding: h and v_D at every sample.
   std::vector<double> h_m, v_D_m_per_s;
   std::vector<Report> reports;  // ascending k, all >= start_step
-  // Aiding: truth at the GNSS epochs j (sample j * gnss_decimation) and the ideal body rate there;
-  // truth height at the barometer epochs; truth attitude at the magnetometer epochs; ZUPT samples.
-  int64_t gnss_decimation = 0, baro_decimation = 0, mag_decimation = 0;
-  std::vector<NavState> gnss_truth;
-  std::vector<Vector3d> gnss_omega_ib_b;
-  std::vector<double> baro_h_m;
+  // Aiding (kInsGnssEkf): the one schedule of the job's aids (aiding.h) and, at each sample where
+  // an aid is due (ascending k), the truth it measures. Magnetometer (kComplementary): the truth
+  // attitude at its epochs j (sample j * mag_decimation).
+  std::shared_ptr<const AidingSchedule> schedule;
+  struct AidingEpoch {
+    int64_t k = 0;
+    uint32_t due = 0;  // AidingSchedule::Due
+    AidingTruth truth;
+  };
+  std::vector<AidingEpoch> aiding_epochs;
+  int64_t mag_decimation = 0;
   std::vector<Quaterniond> mag_q_b_n;
-  std::vector<int64_t> zupt_epochs;
   // kInsGnssEkf: the filter's noise model and initial covariance.
   ErrorStateNoise ekf_noise;
   ErrorStateMatrix ekf_P0;
@@ -169,6 +176,10 @@ std::unique_ptr<TrajectoryGenerator> PrepareSharedTruth(const MonteCarloSpec& sp
 void StreamSharedTruth(const MonteCarloSpec& spec, bool keep_imu, TrajectoryGenerator* generator,
                        SharedTruth* out, const std::atomic<bool>* cancel, bool* cancelled,
                        TruthStream* stream);
+// FilterErrorModel into s->ekf_noise and, with its initial covariance from the initial errors at
+// the navigation start, s->ekf_P0 (for kInsGnssEkf or the covariance analysis; else nothing).
+// Returns the model (with its unrepresented terms).
+ErrorStateNoiseFromImu PrepareFilterModel(const MonteCarloSpec& spec, SharedTruth* s);
 // The error-state model the EKF and the covariance analysis use (MakeErrorStateNoise of the
 // filter's IMU model, spec.filter_sensor or else the truth's), with the GNSS and barometer
 // Gauss-Markov errors as states for the EKF, and the run's time scales and motion bounds.
@@ -193,15 +204,28 @@ bool UseGyrocompass(const MonteCarloSpec& spec, const SharedTruth& truth);
 // ---- montecarlo/runs.cc: one run each through run_loop::RunLoop, its reports into `sink`; false
 // if stopped early, else the run is counted as done in `monitor`.
 class Monitor;
+
+// Sees every sample of one run (ReplayMonteCarloRun: `driftlab simulate --run N`, `export --run
+// N`): called at each k = 0..n after the navigator's step and the report at k, before the aiding
+// updates at k, i.e. with the solution the statistics score. `solution(truth_k)` is the
+// navigator's navigation solution (valid from the navigation start on), `filter` the run's EKF
+// (nullptr for the other navigators). The Monte-Carlo runs pass no observer.
+class RunObserver {
+ public:
+  virtual ~RunObserver() = default;
+  virtual void At(int64_t k, const std::function<NavState(const NavState&)>& solution,
+                  const InsGnssFilter* filter) = 0;
+};
+
 bool RunNed(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, bool gyrocompass,
-            const RunSink& sink, Monitor* monitor);
+            const RunSink& sink, Monitor* monitor, RunObserver* observer = nullptr);
 bool RunSeed000(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, const RunSink& sink,
-                Monitor* monitor);
+                Monitor* monitor, RunObserver* observer = nullptr);
 // With the NEES of the 9 navigation states at every epoch into `nees`.
 bool RunEkf(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, const RunSink& sink,
-            NeesAccumulator* nees, Monitor* monitor);
+            NeesAccumulator* nees, Monitor* monitor, RunObserver* observer = nullptr);
 bool RunComplementary(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run,
-                      const RunSink& sink, Monitor* monitor);
+                      const RunSink& sink, Monitor* monitor, RunObserver* observer = nullptr);
 
 // ---- montecarlo/lockstep_runs.cc
 // All runs of a kNed job in lockstep groups of kernel.width runs, in parallel over groups.

@@ -25,11 +25,11 @@ namespace driftlab {
 
 using mc_detail::Clock;
 using mc_detail::EpochAccumulator;
-using mc_detail::FilterErrorModel;
 using mc_detail::MergeEpochSums;
 using mc_detail::MergeNees;
 using mc_detail::Monitor;
 using mc_detail::NeesAccumulator;
+using mc_detail::PrepareFilterModel;
 using mc_detail::PrepareSharedTruth;
 using mc_detail::Report;
 using mc_detail::RunComplementary;
@@ -81,13 +81,7 @@ MonteCarloOutput RunMonteCarloWithAnalysis(
   auto finish_truth = [&](TruthStream* stream) {
     StreamSharedTruth(spec, true, generator.get(), &shared, cancel, &cancelled_early, stream);
     if (cancelled_early) return;
-    noise = FilterErrorModel(spec, shared);
-    if (ekf || spec.covariance) {
-      shared.ekf_noise = noise.noise;
-      shared.ekf_P0 = InitialErrorCovariance(
-          spec.initial_errors.position_ned_m, spec.initial_errors.velocity_ned_m_per_s,
-          spec.initial_errors.attitude_rad, shared.truth_start.euler(), noise.noise);
-    }
+    noise = PrepareFilterModel(spec, &shared);
     truth_s = Seconds(start);
   };
   auto cancelled_during_truth = [&] {
@@ -223,7 +217,7 @@ MonteCarloOutput RunMonteCarloWithAnalysis(
   }
   if (ekf) output.consistency = MergeNees(nees_accumulators, n_epochs);
   if (spec.covariance) {
-    // The analysis at the epochs' samples, the ZUPT epochs as the runs use them.
+    // The analysis at the epochs' samples, with the runs' aiding schedule.
     std::vector<int64_t> epoch_samples;
     for (const Report& r : truth.reports) {
       if (r.epoch >= 0) epoch_samples.push_back(r.k);
@@ -236,7 +230,7 @@ MonteCarloOutput RunMonteCarloWithAnalysis(
     // that filter; the free INS's uses covariance_step_samples with Van Loan's exact transition.
     analysis.epochs = FilterCovarianceAnalysis(
         spec.simulation.motion, spec.simulation.rate_hz, truth.ekf_noise, truth.ekf_P0,
-        ekf ? &spec.aiding : nullptr, truth.zupt_epochs, epoch_samples, analysis.step_samples,
+        ekf ? truth.schedule.get() : nullptr, epoch_samples, analysis.step_samples,
         ekf ? InsGnssFilterOptions().discretization : Discretization::kVanLoan);
     output.covariance = std::move(analysis);
   }

@@ -26,9 +26,10 @@ const ImuErrorModel* SensorOf(const MonteCarloSpec& spec) {
 // One run of `navigator` over the shared truth's samples k = 0..n through the run's sensor errors,
 // `record(report, navigator)` at each report sample, progress and cancellation through `monitor`.
 // Returns false if stopped early; else the run's samples are counted as done.
+// `observer` (if not null) sees every sample after its report.
 template <class Navigator, class Record>
 bool RunOne(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, Navigator& navigator,
-            Record&& record, Monitor* monitor) {
+            Record&& record, Monitor* monitor, RunObserver* observer) {
   using Input = typename Navigator::Input;
   constexpr bool kPointSamples = std::is_same_v<Input, ImuSample>;
   const std::vector<Input>* ideal = nullptr;
@@ -40,8 +41,14 @@ bool RunOne(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, Navi
   run_loop::StoredImu<Input> measure(*ideal, SensorOf(spec), spec.seed, run, s.rate_hz);
   size_t next = 0;
   const size_t n_reports = s.reports.size();
+  const InsGnssFilter* filter = nullptr;
+  if constexpr (requires { navigator.filter(); }) filter = &navigator.filter();
+  const std::function<NavState(const NavState&)> solution = [&navigator](const NavState& truth) {
+    return NavState(navigator.Solution(truth));
+  };
   auto report = [&](int64_t k, const Navigator& nav) {
     if (next < n_reports && s.reports[next].k == k) record(s.reports[next++], nav);
+    if (observer != nullptr) observer->At(k, solution, filter);
   };
   int64_t polled = 0;
   auto poll = [&](int64_t k) {
@@ -55,19 +62,18 @@ bool RunOne(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, Navi
   return true;
 }
 
-// The INS/GNSS EKF (ins_gnss_filter.h) with the GNSS, barometer and ZUPT measurements of the run.
-// At a sample: predict (Step), report, then the GNSS, barometer and ZUPT updates due at that
-// sample (Correct), in this order (as FilterCovarianceAnalysis). Navigation starts at s0 = 0
-// (initialization TRUTH_PLUS_ERRORS, ValidateFilter).
+// The INS/GNSS EKF (ins_gnss_filter.h) with the run's aiding measurements. At a sample: predict
+// (Step), report, then the updates of the aids the job's schedule (SharedTruth::schedule) has due
+// at that sample (Correct), in the schedule's order (as FilterCovarianceAnalysis). Navigation
+// starts at s0 = 0 (initialization TRUTH_PLUS_ERRORS, ValidateFilter).
 class EkfNavigator {
  public:
   using Input = ImuIncrement;
-  EkfNavigator(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run)
-      : s_(s), aiding_(spec.aiding) {
+  EkfNavigator(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run) : s_(s) {
     InsGnssFilterOptions options;
     options.imu_noise = s.ekf_noise;
-    if (aiding_.gnss) {
-      options.gnss = *aiding_.gnss;
+    if (spec.aiding.gnss) {
+      options.gnss = *spec.aiding.gnss;
     } else {
       options.gnss.rate_hz = s.rate_hz;  // unused; valid for any IMU rate
     }
@@ -76,52 +82,33 @@ class EkfNavigator {
     const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
     filter_.emplace(s.env, NedStartState(s, spec, run, true, zero, zero), s.ekf_P0, s.rate_hz,
                     options);
-    if (aiding_.gnss) gnss_.emplace(*aiding_.gnss, s.env, s.rate_hz, spec.seed, run);
-    if (aiding_.barometer) {
-      baro_.emplace(*aiding_.barometer, s.rate_hz, spec.seed, run);
-      // The bias is a filter state when the filter's model has it; otherwise it widens R.
-      baro_sigma_m_ =
-          s.ekf_noise.barometer_bias_sigma_m > 0.0
-              ? aiding_.barometer->noise_sigma_m
-              : math::Hypot(aiding_.barometer->noise_sigma_m, aiding_.barometer->bias.sigma);
-    }
-    if (aiding_.zupt) zupt_.emplace(*aiding_.zupt, s.rate_hz, spec.seed, run);
+    aids_ = StartAidingRuns(s.schedule->sensors(), s.env, spec.seed, run, filter_->layout(),
+                            s.ekf_noise);
   }
 
   void Step(int64_t k, const ImuIncrement& measured) {
     if (k > s_.start_step) filter_->Predict(measured);
   }
   void Correct(int64_t k, const ImuIncrement& measured) {
-    if (k <= s_.start_step) return;
-    if (gnss_ && k % s_.gnss_decimation == 0) {
-      const size_t j = static_cast<size_t>(k / s_.gnss_decimation);
-      GnssMeasurement fix;
-      if (gnss_->Measure(k, s_.gnss_truth[j], s_.gnss_omega_ib_b[j], &fix)) {
-        filter_->Update(fix, measured.delta_theta_ib_b / s_.dt_s);
+    if (next_ >= s_.aiding_epochs.size() || s_.aiding_epochs[next_].k != k) return;
+    const SharedTruth::AidingEpoch& epoch = s_.aiding_epochs[next_++];
+    for (size_t i = 0; i < aids_.runs.size(); ++i) {
+      if ((epoch.due >> i & 1u) == 0) continue;
+      AidingRun& aid = *aids_.runs[i];
+      if (aid.Measure(k, epoch.truth)) {
+        filter_->Update(aid, measured.delta_theta_ib_b / s_.dt_s, aids_.first_state[i]);
       }
-    }
-    if (baro_ && k % s_.baro_decimation == 0) {
-      double h_m = 0.0;
-      baro_->Measure(k, s_.baro_h_m[static_cast<size_t>(k / s_.baro_decimation)], &h_m);
-      filter_->UpdateHeight(h_m, baro_sigma_m_);
-    }
-    if (next_zupt_ < s_.zupt_epochs.size() && s_.zupt_epochs[next_zupt_] == k) {
-      filter_->UpdateZeroVelocity(aiding_.zupt->velocity_sigma_m_per_s, zupt_->Measure(k));
-      ++next_zupt_;
     }
   }
   const NavState& Solution(const NavState&) const { return filter_->state(); }
   InsGnssFilter& filter() { return *filter_; }
+  const InsGnssFilter& filter() const { return *filter_; }
 
  private:
   const SharedTruth& s_;
-  const AidingSpec& aiding_;
   std::optional<InsGnssFilter> filter_;
-  std::optional<GnssSimulator> gnss_;
-  std::optional<BarometerSimulator> baro_;
-  double baro_sigma_m_ = 0.0;
-  std::optional<ZuptSimulator> zupt_;
-  size_t next_zupt_ = 0;
+  AidingRuns aids_;
+  size_t next_ = 0;  // the next of s_.aiding_epochs
 };
 
 // The complementary attitude filter (complementary_filter.h) on the measured point samples
@@ -166,7 +153,7 @@ class ComplementaryNavigator {
 }  // namespace
 
 bool RunNed(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, bool gyrocompass,
-            const RunSink& sink, Monitor* monitor) {
+            const RunSink& sink, Monitor* monitor, RunObserver* observer) {
   run_loop::NedNavigator navigator(
       s.env, s.dt_s, spec.simulation.ned, s.start_step,
       [&](const Eigen::Vector3d& sum_dtheta, const Eigen::Vector3d& sum_dv) {
@@ -181,22 +168,22 @@ bool RunNed(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, bool
       [&](const Report& r, const auto& nav) {
         sink.Record(r, ComputeNavError(s.env, nav.Solution(r.truth), r.truth));
       },
-      monitor);
+      monitor, observer);
 }
 
 bool RunSeed000(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, const RunSink& sink,
-                Monitor* monitor) {
+                Monitor* monitor, RunObserver* observer) {
   run_loop::Seed000Navigator navigator(s.env, s.truth0, s.dt_s, spec.simulation.seed000);
   return RunOne(
       s, spec, run, navigator,
       [&](const Report& r, const run_loop::Seed000Navigator& nav) {
         sink.Record(r, ComputeNavError(s.env, nav.Solution(r.truth), r.truth));
       },
-      monitor);
+      monitor, observer);
 }
 
 bool RunEkf(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, const RunSink& sink,
-            NeesAccumulator* nees, Monitor* monitor) {
+            NeesAccumulator* nees, Monitor* monitor, RunObserver* observer) {
   EkfNavigator navigator(s, spec, run);
   InsGnssFilter& filter = navigator.filter();
   auto record = [&](const Report& r, const EkfNavigator&) {
@@ -214,18 +201,18 @@ bool RunEkf(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run, cons
     nees->sum[static_cast<size_t>(r.epoch)].Add(value);
     ++nees->count[static_cast<size_t>(r.epoch)];
   };
-  return RunOne(s, spec, run, navigator, record, monitor);
+  return RunOne(s, spec, run, navigator, record, monitor, observer);
 }
 
 bool RunComplementary(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run,
-                      const RunSink& sink, Monitor* monitor) {
+                      const RunSink& sink, Monitor* monitor, RunObserver* observer) {
   ComplementaryNavigator navigator(s, spec, run);
   return RunOne(
       s, spec, run, navigator,
       [&](const Report& r, const ComplementaryNavigator& nav) {
         sink.Record(r, ComputeNavError(s.env, nav.Solution(r.truth), r.truth));
       },
-      monitor);
+      monitor, observer);
 }
 
 }  // namespace driftlab::mc_detail

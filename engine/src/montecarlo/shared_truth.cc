@@ -37,27 +37,16 @@ std::unique_ptr<TrajectoryGenerator> PrepareSharedTruth(const MonteCarloSpec& sp
   s.reports = std::move(plan.reports);
 
   const AidingSpec& aiding = spec.aiding;
-  if (keep_imu && aiding.gnss) {
-    s.gnss_decimation = AidingDecimation(aiding.gnss->rate_hz, s.rate_hz, "aiding.gnss.rate_hz");
-    s.gnss_truth.resize(static_cast<size_t>(s.n / s.gnss_decimation) + 1);
-    s.gnss_omega_ib_b.resize(s.gnss_truth.size(), Vector3d::Zero());
-    s.gnss_truth[0] = s.truth0;
-  }
-  if (keep_imu && aiding.barometer) {
-    s.baro_decimation =
-        AidingDecimation(aiding.barometer->rate_hz, s.rate_hz, "aiding.barometer.rate_hz");
-    s.baro_h_m.resize(static_cast<size_t>(s.n / s.baro_decimation) + 1);
-    s.baro_h_m[0] = s.truth0.llh.h_m;
+  if (keep_imu && spec.filter == NavigationFilterKind::kInsGnssEkf) {
+    s.schedule = std::make_shared<const AidingSchedule>(
+        MakeAidingSensors(aiding, s.rate_hz), s.rate_hz, s.start_step + 1, s.n,
+        [&](double t) { return generator.IsStaticAt(t); });
   }
   if (keep_imu && aiding.magnetometer) {
     s.mag_decimation =
         AidingDecimation(aiding.magnetometer->rate_hz, s.rate_hz, "aiding.magnetometer.rate_hz");
     s.mag_q_b_n.resize(static_cast<size_t>(s.n / s.mag_decimation) + 1);
     s.mag_q_b_n[0] = s.truth0.q_b_n;
-  }
-  if (keep_imu && aiding.zupt) {
-    s.zupt_epochs = ZuptEpochs(*aiding.zupt, s.rate_hz, s.start_step + 1, s.n,
-                               [&](double t) { return generator.IsStaticAt(t); });
   }
   // Point samples for mechanization B and the complementary filter, increments otherwise.
   const bool point_samples = seed000 || spec.filter == NavigationFilterKind::kComplementary;
@@ -114,13 +103,12 @@ void StreamSharedTruth(const MonteCarloSpec& spec, bool keep_imu, TrajectoryGene
     } else if (keep_imu) {
       s.increments[uk] = sample.increment;
     }
-    if (s.gnss_decimation > 0 && k % s.gnss_decimation == 0) {
-      const size_t j = static_cast<size_t>(k / s.gnss_decimation);
-      s.gnss_truth[j] = sample.truth;
-      s.gnss_omega_ib_b[j] = sample.increment.delta_theta_ib_b / s.dt_s;
-    }
-    if (s.baro_decimation > 0 && k % s.baro_decimation == 0) {
-      s.baro_h_m[static_cast<size_t>(k / s.baro_decimation)] = sample.truth.llh.h_m;
+    if (s.schedule) {
+      const uint32_t due = s.schedule->Due(k, sample.truth.t_s);
+      if (due != 0) {
+        s.aiding_epochs.push_back(SharedTruth::AidingEpoch{
+            k, due, AidingTruth{sample.truth, sample.increment.delta_theta_ib_b / s.dt_s}});
+      }
     }
     if (s.mag_decimation > 0 && k % s.mag_decimation == 0) {
       s.mag_q_b_n[static_cast<size_t>(k / s.mag_decimation)] = sample.truth.q_b_n;
@@ -133,6 +121,17 @@ void StreamSharedTruth(const MonteCarloSpec& spec, bool keep_imu, TrajectoryGene
     if (stream != nullptr && (k & (kTruthPublishSamples - 1)) == 0) stream->Publish(k);
   }
   if (stream != nullptr) stream->Publish(s.n);
+}
+
+ErrorStateNoiseFromImu PrepareFilterModel(const MonteCarloSpec& spec, SharedTruth* s) {
+  ErrorStateNoiseFromImu noise = FilterErrorModel(spec, *s);
+  if (spec.filter == NavigationFilterKind::kInsGnssEkf || spec.covariance) {
+    s->ekf_noise = noise.noise;
+    s->ekf_P0 = InitialErrorCovariance(
+        spec.initial_errors.position_ned_m, spec.initial_errors.velocity_ned_m_per_s,
+        spec.initial_errors.attitude_rad, s->truth_start.euler(), noise.noise);
+  }
+  return noise;
 }
 
 ErrorStateNoiseFromImu FilterErrorModel(const MonteCarloSpec& spec, const SharedTruth& s) {
@@ -172,13 +171,13 @@ ErrorStateNoiseFromImu FilterErrorModel(const MonteCarloSpec& spec, const Shared
         "is the filter's belief, a mistuning shows as NEES outside its band)";
     out.unrepresented.push_back(kMistuned);
   }
-  if (ekf && spec.aiding.gnss && !spec.aiding.gnss->position_gauss_markov_sigma_ned_m.isZero(0.0)) {
-    out.noise.gnss_position_gm_sigma_ned_m = spec.aiding.gnss->position_gauss_markov_sigma_ned_m;
-    out.noise.gnss_position_gm_tau_s = spec.aiding.gnss->position_gauss_markov_tau_s;
-  }
-  if (ekf && spec.aiding.barometer && spec.aiding.barometer->bias.sigma > 0.0) {
-    out.noise.barometer_bias_sigma_m = spec.aiding.barometer->bias.sigma;
-    out.noise.barometer_bias_tau_s = spec.aiding.barometer->bias.tau_s;
+  // The aids' own error states (GNSS Gauss-Markov error, barometer bias, ...), in their order.
+  if (ekf) {
+    for (const auto& sensor : MakeAidingSensors(spec.aiding, s.rate_hz)) {
+      for (AidingErrorStates& states : sensor->ErrorStates()) {
+        out.noise.aiding_states.push_back(std::move(states));
+      }
+    }
   }
   return out;
 }

@@ -1,6 +1,9 @@
-// Single-run simulation: ideal IMU data from the trajectory generator, optionally through a sensor
-// error model, through mechanization A or B, errors against the truth at every step; the engine's
-// run loop (run_loop.h) with a report at every sample and no cancellation.
+// Single-run simulation. SimulateMonteCarloRun: run N of a job (initial errors, alignment, aiding,
+// filter) through ReplayMonteCarloRun, the Monte Carlo's own run with an observer at every sample.
+// RunSimulation: ideal IMU data from the trajectory generator, optionally through a sensor error
+// model, through mechanization A (from the true initial state) or B, errors against the truth at
+// every step; the engine's run loop (run_loop.h) with a report at every sample and no
+// cancellation (the mechanizations' closure tests).
 #include "driftlab/simulate.h"
 
 #include <algorithm>
@@ -8,6 +11,7 @@
 #include <string>
 #include <utility>
 
+#include "driftlab/monte_carlo.h"
 #include "driftlab/sensors.h"
 #include "driftlab/spec_error.h"
 #include "montecarlo/run_loop.h"
@@ -28,6 +32,38 @@ void Accumulate(const NavError& e, SimulationSummary* summary) {
 }
 
 }  // namespace
+
+SimulationSummary SimulateMonteCarloRun(
+    const MonteCarloSpec& spec, uint32_t run,
+    const std::function<void(const SimulationStep&, const InsGnssFilter*)>& on_step) {
+  SimulationSummary summary;
+  const NavEnvironment* env = nullptr;
+  NavError error;
+  ReplayMonteCarloRun(
+      spec, run, /*navigate=*/true,
+      [&](const MonteCarloRunLayout& layout) {
+        env = layout.env;
+        summary.steps = layout.num_steps;
+        summary.duration_s = static_cast<double>(layout.num_steps) * layout.dt_s;
+      },
+      [&](const MonteCarloRunStep& r) {
+        SimulationStep step;
+        step.k = r.k;
+        step.truth = r.truth;
+        step.increment = r.increment;
+        step.sample = r.sample;
+        step.measured_increment = r.measured_increment;
+        step.measured_sample = r.measured_sample;
+        if (r.nav != nullptr) {
+          error = ComputeNavError(*env, *r.nav, *r.truth);
+          Accumulate(error, &summary);
+          step.nav = r.nav;
+          step.error = &error;
+        }
+        if (on_step) on_step(step, r.filter);
+      });
+  return summary;
+}
 
 SimulationSummary RunErrorFreeSimulation(
     const SimulationSpec& spec, const std::function<void(const SimulationStep&)>& on_step) {

@@ -98,9 +98,8 @@ void ValidateFilter(const MonteCarloSpec& spec) {
                       "only with navigation.filter " + filter + " (the filter is " + name + ")");
     }
   };
-  only_with(a.gnss.has_value(), "aiding.gnss", "INS_GNSS_EKF");
-  only_with(a.barometer.has_value(), "aiding.barometer", "INS_GNSS_EKF");
-  only_with(a.zupt.has_value(), "aiding.zupt", "INS_GNSS_EKF");
+  const std::vector<std::string> ekf_aids = AidingSensorPaths(a);
+  for (const std::string& path : ekf_aids) only_with(true, path, "INS_GNSS_EKF");
   only_with(a.magnetometer.has_value(), "aiding.magnetometer", "COMPLEMENTARY");
   if (spec.filter_flicker_states_per_axis < 1 ||
       spec.filter_flicker_states_per_axis > kMaxFlickerComponents) {
@@ -118,10 +117,11 @@ void ValidateFilter(const MonteCarloSpec& spec) {
     ValidateImuErrorModel(*spec.filter_sensor, "navigation.ekf.sensor");
   }
   if (f == NavigationFilterKind::kInsGnssEkf) {
-    if (!a.gnss && !a.barometer && !a.zupt) {
+    if (ekf_aids.empty()) {
       throw SpecError("navigation.filter", name,
                       "INS_GNSS_EKF with at least one of aiding.gnss, aiding.barometer, "
-                      "aiding.zupt (an EKF without measurements is the free INS: use NONE)");
+                      "aiding.zupt or another aiding sensor of the EKF (docs/aiding.md; an EKF "
+                      "without measurements is the free INS: use NONE)");
     }
     if (!free_vertical) {
       throw SpecError("navigation.ned.vertical_channel", "TRUTH_HEIGHT",
@@ -337,10 +337,14 @@ uint64_t MemoryOfPlan(const MonteCarloSpec& spec, const JobPlan& plan, double ra
                      item_bytes
                : uint64_t{0};
   };
-  if (spec.aiding.gnss) bytes += per_rate(spec.aiding.gnss->rate_hz, sizeof(NavState) + 24);
-  if (spec.aiding.barometer) bytes += per_rate(spec.aiding.barometer->rate_hz, sizeof(double));
+  // The truth at the aiding epochs (SharedTruth::AidingEpoch, at most one per aid and epoch) and
+  // the ZUPT windows' epochs.
+  for (const auto& aid : MakeAidingSensors(spec.aiding, rate_hz)) {
+    const uint64_t epochs = samples / static_cast<uint64_t>(aid->decimation()) + 1;
+    bytes += epochs * (sizeof(NavState) + sizeof(Vector3d) + 16);
+    if (aid->OnlyWhileStatic()) bytes += epochs * sizeof(int64_t);
+  }
   if (spec.aiding.magnetometer) bytes += per_rate(spec.aiding.magnetometer->rate_hz, 32);
-  if (spec.aiding.zupt) bytes += samples * sizeof(int64_t);
   size_t epochs = 0, checkpoints = 0;
   for (const Report& r : plan.reports) {
     epochs += r.epoch >= 0;

@@ -226,10 +226,8 @@ StructuredCase MakeStructuredCase() {
   ErrorModelOptions three;
   three.flicker_states_per_axis = 3;
   c.noise = MakeErrorStateNoise(FindImuPreset("tactical"), "sensor", three).noise;
-  c.noise.gnss_position_gm_sigma_ned_m = Vector3d(0.5, 0.5, 1.0);
-  c.noise.gnss_position_gm_tau_s = 100.0;
-  c.noise.barometer_bias_sigma_m = 2.0;
-  c.noise.barometer_bias_tau_s = 300.0;
+  c.noise.aiding_states.push_back(AidingErrorStates{"aiding.gnss", {0.5, 0.5, 1.0}, 100.0});
+  c.noise.aiding_states.push_back(AidingErrorStates{"aiding.barometer", {2.0}, 300.0});
   const int n = ErrorStateLayout(c.noise).size;
   Eigen::MatrixXd A = Eigen::MatrixXd::Random(n, n) * 1e-3;
   c.P0 = A * A.transpose() + InitialErrorCovariance(Vector3d(1, 1, 2), Vector3d(0.1, 0.1, 0.1),

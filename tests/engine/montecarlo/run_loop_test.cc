@@ -7,9 +7,11 @@
 
 #include <atomic>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
+#include "driftlab/gnss.h"
 #include "driftlab/mc_statistics.h"
 #include "driftlab/monte_carlo.h"
 #include "driftlab/presets.h"
@@ -48,6 +50,13 @@ void ExpectReplayScoresAsRunMonteCarlo(const MonteCarloSpec& spec) {
               ErrorComponentsOf(ComputeNavError(*env, *step.nav, *step.truth));
           const CheckpointValues& cp = checkpoints[static_cast<size_t>(step.checkpoint)];
           EXPECT_EQ(step.report_t_s, cp.t_s);
+          // The replay's own record of the run's values, as RunMonteCarlo keeps them.
+          ASSERT_NE(step.checkpoint_values, nullptr);
+          for (int c = 0; c < kNumErrorComponents; ++c) {
+            EXPECT_EQ(std::bit_cast<uint64_t>((*step.checkpoint_values)[c]),
+                      std::bit_cast<uint64_t>(cp.values[run][c]))
+                << "run " << run << " checkpoint " << step.checkpoint << " component " << c;
+          }
           for (int c = 0; c < kNumErrorComponents; ++c) {
             EXPECT_EQ(std::bit_cast<uint64_t>(v[c]), std::bit_cast<uint64_t>(cp.values[run][c]))
                 << "run " << run << " checkpoint " << step.checkpoint << " component " << c;
@@ -79,6 +88,70 @@ TEST(RunLoopTest, ReplayedSeed000RunScoresAsRunMonteCarlo) {
   spec.simulation.seed000.static_period_s = 15.0;
   spec.initial_errors = InitialErrorSigmas();
   ExpectReplayScoresAsRunMonteCarlo(spec);
+}
+
+// The INS/GNSS EKF with initial errors and GNSS fixes (with a lever arm, a Gauss-Markov error as a
+// filter state and an outage) and a barometer: the replayed run is the Monte Carlo's run.
+MonteCarloSpec SmallEkfJob() {
+  MonteCarloSpec spec = SmallJob();
+  spec.filter = NavigationFilterKind::kInsGnssEkf;
+  GnssConfig gnss;
+  gnss.rate_hz = 2.0;
+  gnss.lever_arm_b_m = Vector3d(0.5, 0.0, -1.0);
+  gnss.position_gauss_markov_sigma_ned_m = Vector3d(0.5, 0.5, 1.0);
+  gnss.outages.push_back(GnssOutage{35.0, 10.0});
+  spec.aiding.gnss = gnss;
+  BarometerConfig baro;
+  baro.rate_hz = 5.0;
+  baro.bias.sigma = 1.0;
+  baro.bias.tau_s = 300.0;
+  spec.aiding.barometer = baro;
+  return spec;
+}
+
+TEST(RunLoopTest, ReplayedEkfRunWithInitialErrorsAndGnssScoresAsRunMonteCarlo) {
+  ExpectReplayScoresAsRunMonteCarlo(SmallEkfJob());
+}
+
+// `driftlab simulate --run N` (SimulateMonteCarloRun): its errors at the checkpoints are run N's
+// values of RunMonteCarlo to the bit, for the EKF job with initial errors and GNSS and for a
+// free-inertial job with initial errors and static alignment; no solution before the alignment
+// window ends.
+TEST(RunLoopTest, SimulatedRunNIsRunNOfTheMonteCarlo) {
+  MonteCarloSpec aligned = SmallJob();
+  aligned.initialization = InitializationKind::kStaticAlignment;
+  aligned.alignment.duration_s = 15.0;
+  aligned.initial_errors.attitude_rad = Vector3d::Zero();
+  for (const MonteCarloSpec& spec : {SmallEkfJob(), aligned}) {
+    const MonteCarloStatistics stats = RunMonteCarlo(spec);
+    const std::vector<CheckpointValues>& checkpoints = stats.data().checkpoints;
+    ASSERT_EQ(checkpoints.size(), 3u);
+    const bool ekf = spec.filter == NavigationFilterKind::kInsGnssEkf;
+    const int64_t start = ekf ? 0 : 300;  // 15 s at 20 Hz
+    for (const uint32_t run : {0u, 3u}) {
+      size_t next = 0;
+      int64_t rows = 0;
+      const SimulationSummary summary = SimulateMonteCarloRun(
+          spec, run, [&](const SimulationStep& step, const InsGnssFilter* filter) {
+            EXPECT_EQ(step.nav != nullptr, step.k >= start) << step.k;
+            EXPECT_EQ(filter != nullptr, ekf && step.k >= start) << step.k;
+            if (step.nav != nullptr) ++rows;
+            if (next < checkpoints.size() &&
+                std::abs(checkpoints[next].t_s - step.truth->t_s) < 1e-9) {
+              const ErrorComponentValues v = ErrorComponentsOf(*step.error);
+              for (int c = 0; c < kNumErrorComponents; ++c) {
+                EXPECT_EQ(std::bit_cast<uint64_t>(v[c]),
+                          std::bit_cast<uint64_t>(checkpoints[next].values[run][c]))
+                    << "run " << run << " checkpoint " << next << " component " << c;
+              }
+              ++next;
+            }
+          });
+      EXPECT_EQ(next, checkpoints.size());
+      EXPECT_EQ(summary.steps, 1200);
+      EXPECT_EQ(rows, 1201 - start);
+    }
+  }
 }
 
 // RunSimulation of (seed, run) and the replay of run `run` of a job with that seed: the same
