@@ -150,7 +150,7 @@ std::string BashCompletion(const CLI::App& app) {
       for (const std::string& l : option->get_lnames()) names.push_back("--" + l);
       for (const std::string& s : option->get_snames()) names.push_back("-" + s);
       flags.insert(flags.end(), names.begin(), names.end());
-      if (option->get_type_size_max() == 0) continue;  // a flag: no value follows
+      if (option->get_expected_max() == 0) continue;  // a flag: no value follows
       std::string pattern;
       for (const std::string& n : names) {
         if (!ShellSafe(n)) continue;

@@ -279,7 +279,7 @@ TEST(HtmlReport, ExtremeValuesRenderWithoutNonFinite) {
   // A structurally valid result holding means of +-1e308 (the CLI refuses it: its per-run values
   // do not give them; the renderer must still cope): fmt must not see a negative precision, and
   // neither the text nor the plot data hold a non-finite number.
-  const std::string json = Slurp(kData / "gate_baseline.json");
+  const std::string json = Slurp(kCliData / "gate_baseline.json");
   const std::regex mean(R"re("mean": [-0-9.eE+]+)re");
   std::string text;
   size_t copied = 0;

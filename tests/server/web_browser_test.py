@@ -3,7 +3,7 @@
 WebDriver protocol (plain HTTP + JSON, urllib).
 
 Usage: web_browser_test.py SERVER_BINARY CLI_BINARY WORK_DIR [--screenshots DIR]
-(PYTHONPATH: <build>/python and clients/python, for the gRPC client.)
+(PYTHONPATH: <build>/python, for the driftlab package and its gRPC modules.)
 
 Starts driftlab-server on 127.0.0.1 (gRPC and --http-port on ephemeral ports, a tokens file, two
 jobs at once) and Chromium (Debian's chromium and chromium-driver), then, as a person would:
@@ -176,7 +176,7 @@ def main():
         print("SKIP: chromium or chromedriver is not installed (Debian packages chromium and "
               "chromium-driver; scripts/ci-packages.sh installs them)")
         return 77
-    from driftlab_client import connect  # noqa: E402 (needs PYTHONPATH)
+    from driftlab import connect  # noqa: E402 (the package in <build>/python: PYTHONPATH)
     import browser_test  # tests/report/browser_test.py: the tumble recording
 
     work = pathlib.Path(work)
@@ -268,7 +268,7 @@ def main():
         wait_for(lambda: "CANCELLED" in browser.js(
             "var s = document.querySelector('section.status'); return s ? s.textContent : '';"),
             30, "CANCELLED on the cancelled job's page")
-        state = client.get(cancelled).state
+        state = client.status(cancelled).state
         from driftlab.v1 import service_pb2
         if state != service_pb2.CANCELLED:
             fail(f"after the page's cancel the gRPC client sees state {state}")

@@ -49,7 +49,7 @@ std::string YamlError(const std::string& yaml) {
 
 TEST(JobSpec, YamlJobEqualsItsJsonTwin) {
   const JobFile yaml = LoadJobFile(kExamples / "aircraft_climb_turns.yaml");
-  const JobFile json = LoadJobFile(kTestData / "aircraft_climb_turns_twin.json");
+  const JobFile json = LoadJobFile(kCliData / "aircraft_climb_turns_twin.json");
   EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(yaml.job, json.job))
       << yaml.job.DebugString() << "\nvs\n"
       << json.job.DebugString();
