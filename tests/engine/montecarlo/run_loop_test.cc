@@ -93,7 +93,7 @@ TEST(RunLoopTest, ReplayedSeed000RunScoresAsRunMonteCarlo) {
 // The INS/GNSS EKF with initial errors and GNSS fixes (with a lever arm, a Gauss-Markov error as a
 // filter state and an outage) and a barometer: the replayed run is the Monte Carlo's run.
 MonteCarloSpec SmallEkfJob() {
-  MonteCarloSpec spec = SmallJob();
+  MonteCarloSpec spec = FourRunCheckpointJob();
   spec.filter = NavigationFilterKind::kInsGnssEkf;
   GnssConfig gnss;
   gnss.rate_hz = 2.0;
@@ -118,7 +118,7 @@ TEST(RunLoopTest, ReplayedEkfRunWithInitialErrorsAndGnssScoresAsRunMonteCarlo) {
 // free-inertial job with initial errors and static alignment; no solution before the alignment
 // window ends.
 TEST(RunLoopTest, SimulatedRunNIsRunNOfTheMonteCarlo) {
-  MonteCarloSpec aligned = SmallJob();
+  MonteCarloSpec aligned = FourRunCheckpointJob();
   aligned.initialization = InitializationKind::kStaticAlignment;
   aligned.alignment.duration_s = 15.0;
   aligned.initial_errors.attitude_rad = Vector3d::Zero();
