@@ -236,6 +236,15 @@ class TrajectoryGenerator {
   // (the times of their executor steps), ascending and merged, clipped to the duration; empty for
   // other motions. A job with GNSS aiding turns them into outages.
   const std::vector<std::pair<double, double>>& gps_invisible_s() const;
+  // Where the planned motion first reaches |pitch| >= 89.9 deg, if it does: the field that
+  // planned it (segment path, gnss-ins-sim file and line, truth-profile row) and the message. There
+  // roll and yaw are undefined, so Euler-angle errors lose their meaning; the truth and the IMU
+  // data are valid through it (ValidateMonteCarloSpec refuses such a motion).
+  struct EulerSingularity {
+    std::string field;
+    std::string message;
+  };
+  const std::optional<EulerSingularity>& euler_singularity() const;
   // True while the vehicle is static (speed and angular rate w.r.t. the Earth both exactly zero) at
   // t, in [0, duration]; left-continuous like the point samples (true at the end time of a static
   // segment).

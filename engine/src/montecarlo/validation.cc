@@ -383,6 +383,11 @@ void ValidateMonteCarloSpec(const MonteCarloSpec& spec) {
   ValidateSpec(spec);
   if (spec.sensor) ValidateImuErrorModel(*spec.sensor, "sensor");
   const TrajectoryGenerator generator(spec.simulation.motion, spec.simulation.rate_hz);
+  // The Monte Carlo's statistics of roll, pitch and yaw errors mean nothing where roll and yaw are
+  // undefined.
+  if (const auto& singular = generator.euler_singularity()) {
+    throw SpecError(singular->field, singular->message, 0);
+  }
   const JobPlan plan = PlanJob(spec, generator);
   const uint64_t runs = spec.run_count == 0 ? spec.runs - spec.first_run : spec.run_count;
   size_t checkpoints = 0;

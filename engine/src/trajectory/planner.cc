@@ -16,6 +16,10 @@ void Planner::Plan() {
   for (size_t i = 0; i < motion_.segments.size(); ++i) {
     const std::string path = motion_.field_path + ".segments[" + std::to_string(i) + "]";
     if (!std::holds_alternative<GnssInsSimCommand>(motion_.segments[i])) FinishExecutor(false);
+    const auto* command = std::get_if<GnssInsSimCommand>(&motion_.segments[i]);
+    origins_.push_back(SegmentOrigin{
+        exec_.active ? exec_.t_start + static_cast<double>(exec_.steps) * dt_s_ : state_.t,
+        command != nullptr && !command->source.empty() ? command->source : path});
     std::visit([&](const auto& segment) { PlanSegment(segment, path); }, motion_.segments[i]);
   }
   FinishExecutor(true);
@@ -167,6 +171,16 @@ void Planner::AddTurn(double omega, double transition_s, double hold_s) {
   if (Tr > 0.0) Add(Tr, piece(state_.chi, omega, -omega / (2.0 * Tr)));
 }
 
+void Planner::CheckImpliedTurnRate(const std::string& field, double radius_m, double V) const {
+  const double omega = V / radius_m;
+  if (!(omega <= kMaxTurnRate_rad_per_s)) {
+    Reject(field, radius_m,
+           "radius_m >= " + CompactText(V / kMaxTurnRate_rad_per_s) + " m at the ground speed " +
+               CompactText(V) + " m/s (a turn rate of at most " +
+               CompactText(kMaxTurnRate_rad_per_s * kRadToDeg) + " deg/s, as for rate_deg_per_s)");
+  }
+}
+
 void Planner::PlanSegment(const TurnSegment& s, const std::string& path) {
   const std::string base = path + ".turn";
   if (s.rate_rad_per_s.has_value() == s.radius_m.has_value()) {
@@ -182,7 +196,7 @@ void Planner::PlanSegment(const TurnSegment& s, const std::string& path) {
   double omega;
   if (s.rate_rad_per_s) {
     omega = *s.rate_rad_per_s;
-    if (!(std::isfinite(omega) && omega != 0.0 && std::abs(omega) <= 4.0 * M_PI)) {
+    if (!(std::isfinite(omega) && omega != 0.0 && std::abs(omega) <= kMaxTurnRate_rad_per_s)) {
       Reject(base + ".rate_deg_per_s", omega * kRadToDeg,
              "-720 <= rate_deg_per_s <= 720 deg/s, not 0");
     }
@@ -194,6 +208,7 @@ void Planner::PlanSegment(const TurnSegment& s, const std::string& path) {
                  "speed > 0 (give rate_deg_per_s to turn on the spot)");
     }
     omega = (s.right ? 1.0 : -1.0) * V / *s.radius_m;
+    CheckImpliedTurnRate(base + ".radius_m", *s.radius_m, V);
   }
   const double Tr = s.transition_s;
   CheckNonNegative(base + ".transition_s", Tr, kMaxDuration_s / 2.0, " s");
@@ -427,7 +442,7 @@ void Planner::PlanSegment(const FigureEightSegment& s, const std::string& path) 
   TrackStart(&V, &chi, &vD);
   double omega;
   if (s.rate_rad_per_s) {
-    if (!(*s.rate_rad_per_s > 0.0 && *s.rate_rad_per_s <= 4.0 * M_PI)) {
+    if (!(*s.rate_rad_per_s > 0.0 && *s.rate_rad_per_s <= kMaxTurnRate_rad_per_s)) {
       Reject(base + ".rate_deg_per_s", *s.rate_rad_per_s * kRadToDeg,
              "0 < rate_deg_per_s <= 720 deg/s");
     }
@@ -438,6 +453,7 @@ void Planner::PlanSegment(const FigureEightSegment& s, const std::string& path) 
       RejectText(base + ".radius_m", "given at ground speed 0; allowed: speed > 0");
     }
     omega = V / *s.radius_m;
+    CheckImpliedTurnRate(base + ".radius_m", *s.radius_m, V);
   }
   const double Tr = s.transition_s;
   CheckNonNegative(base + ".transition_s", Tr, kMaxDuration_s / 2.0, " s");

@@ -2,6 +2,8 @@
 // each segment's fields as it plans it. Private to the trajectory generator.
 #pragma once
 
+#include <cmath>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -23,6 +25,13 @@ struct PlanState {
   Vector3d v_b = Vector3d::Zero();
 };
 
+// Where a part of the planned motion comes from: it starts at t_s [s]; `field` names it in
+// messages.
+struct SegmentOrigin {
+  double t_s = 0.0;
+  std::string field;
+};
+
 class Planner {
  public:
   Planner(const MotionSpec& motion, const NavEnvironment& env, double rate_hz,
@@ -39,6 +48,9 @@ class Planner {
 
   void Plan();
   double duration() const { return state_.t; }
+  // Each segment's start time [s] and the field a message about it names (its path, or for a
+  // gnss-ins-sim command read from a file, the file and line), in the segments' order.
+  const std::vector<SegmentOrigin>& origins() const { return origins_; }
 
  private:
   // Start values of the parametric model.
@@ -53,6 +65,10 @@ class Planner {
   // Turn pieces: rate ramps 0 -> omega over transition_s, holds for hold_s, ramps back to 0. All
   // pieces share the attitude offsets fixed at the turn's start (chi' = 0 there).
   void AddTurn(double omega, double transition_s, double hold_s);
+  // Turns and figure eights: at most 720 deg/s, given as a rate or implied by radius and speed.
+  static constexpr double kMaxTurnRate_rad_per_s = 4.0 * M_PI;
+  // A radius at ground speed V [m/s] whose turn rate V / radius exceeds kMaxTurnRate_rad_per_s.
+  void CheckImpliedTurnRate(const std::string& field, double radius_m, double V) const;
   void PlanSegment(const TurnSegment& s, const std::string& path);
   void PlanSegment(const ClimbSegment& s, const std::string& path);
   void PlanSegment(const ZigzagSegment& s, const std::string& path);
@@ -121,6 +137,7 @@ class Planner {
   // Ends a block of consecutive gnss-ins-sim commands; `drop_last_step` when the motion ends with
   // it (gnss-ins-sim's output stops at the state before the executor's last step).
   void FinishExecutor(bool drop_last_step);
+  std::vector<SegmentOrigin> origins_;
   const MotionSpec& motion_;
   std::vector<Piece>* pieces_;
   std::vector<std::pair<double, double>>* gps_invisible_s_;
@@ -134,5 +151,29 @@ class Planner {
 // The truth profile's samples as not-a-knot cubic splines of velocity and attitude (one piece
 // per interval); checks the samples (finite, times increasing, duration within the limit).
 void PlanTruthProfile(const MotionSpec& motion, std::vector<Piece>* pieces);
+
+// A truth profile's positions against its velocities: between consecutive samples i, i+1 the
+// displacement from their positions (NED metres at sample i, env.PositionErrorNed) must agree with
+// the integral of the velocity splines (the motion the generator integrates: its positions after
+// the first sample come from the velocities) within 10 m + 10 % of the displacement. A sampled
+// smooth motion meets it by orders of magnitude (the spline's error is O(h^4) of the velocity's
+// third derivative); a position jump (a wrong row, degrees read as radians) does not. Throws
+// SpecError naming `truth_profile[i+1]`.
+void CheckTruthProfilePositions(const MotionSpec& motion, const NavEnvironment& env,
+                                const std::vector<Piece>& pieces);
+
+// Limits of the planned motion, whatever its source (segments, a gnss-ins-sim file, a truth
+// profile), checked on the pieces at every sub-step (the generator's integration grid) and at
+// their ends:
+//  - |pitch| < 89.9 deg: at +-90 deg roll and yaw are undefined (the Euler angles' gimbal lock) and
+//    the roll, pitch and yaw errors of the results lose their meaning; not an error of the motion
+//    (the truth is valid through it): the first place is returned in *singularity;
+//  - body angular rate |omega_nb_b| <= 100 rad/s (the gnss-ins-sim commands' rate limit);
+//  - acceleration |dv_eb_n/dt| <= 1000 m/s^2 (the segments' and commands' acceleration limit).
+// Throws SpecError naming the origin in which the offending piece starts (`origins` ascending in
+// time, the first at 0) and the time reached.
+void CheckPlannedKinematics(const std::vector<Piece>& pieces,
+                            const std::vector<SegmentOrigin>& origins,
+                            std::optional<TrajectoryGenerator::EulerSingularity>* singularity);
 
 }  // namespace driftlab::trajectory_detail

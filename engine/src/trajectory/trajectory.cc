@@ -68,6 +68,7 @@ constexpr double kGaussWeight[4] = {0.347854845137453857373, 0.65214515486254614
 
 struct TrajectoryGenerator::Impl {
   NavEnvironment env;
+  std::optional<EulerSingularity> euler_singularity;
   std::string field_path;
   double rate_hz = 0.0;
   double dt_s = 0.0;
@@ -233,9 +234,17 @@ TrajectoryGenerator::TrajectoryGenerator(const MotionSpec& motion, double rate_h
     Planner planner(motion, m.env, rate_hz, &m.pieces, &m.gps_invisible_s);
     planner.Plan();
     m.duration_s = planner.duration();
+    CheckPlannedKinematics(m.pieces, planner.origins(), &m.euler_singularity);
   } else {
     PlanTruthProfile(motion, &m.pieces);
     m.duration_s = m.pieces.back().t1;
+    std::vector<SegmentOrigin> origins;
+    for (size_t i = 0; i < m.pieces.size(); ++i) {
+      origins.push_back(SegmentOrigin{
+          m.pieces[i].t0, motion.field_path + ".truth_profile[" + std::to_string(i) + "]"});
+    }
+    CheckPlannedKinematics(m.pieces, origins, &m.euler_singularity);
+    CheckTruthProfilePositions(motion, m.env, m.pieces);
   }
   if (m.pieces.empty() || !(m.duration_s > 0.0)) {
     RejectText(motion.field_path + ".segments",
@@ -298,6 +307,10 @@ const std::vector<std::pair<double, double>>& TrajectoryGenerator::gps_invisible
   return impl_->gps_invisible_s;
 }
 int64_t TrajectoryGenerator::step() const { return impl_->step; }
+const std::optional<TrajectoryGenerator::EulerSingularity>& TrajectoryGenerator::euler_singularity()
+    const {
+  return impl_->euler_singularity;
+}
 
 bool TrajectoryGenerator::IsStaticAt(double t_s) const {
   if (!(t_s >= 0.0 && t_s <= impl_->duration_s)) return false;

@@ -1,5 +1,7 @@
 // The truth profile as cubic splines (planner.h).
+#include <algorithm>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "driftlab/attitude.h"
@@ -136,6 +138,35 @@ void PlanTruthProfile(const MotionSpec& motion, std::vector<Piece>* pieces) {
     }
     piece.kin = sp;
     pieces->push_back(piece);
+  }
+}
+
+void CheckTruthProfilePositions(const MotionSpec& motion, const NavEnvironment& env,
+                                const std::vector<Piece>& pieces) {
+  const std::vector<TruthProfileSample>& samples = motion.truth_profile;
+  for (size_t i = 0; i + 1 < samples.size() && i < pieces.size(); ++i) {
+    const auto* spline = std::get_if<SplinePiece>(&pieces[i].kin);
+    if (spline == nullptr) continue;
+    const double h = pieces[i].t1 - pieces[i].t0;
+    // Integral over [0, h] of c0 + c1 s + c2 s^2 + c3 s^3, per velocity channel.
+    Vector3d integral;
+    for (int c = 0; c < 3; ++c) {
+      const auto& k = spline->c[static_cast<size_t>(c)];
+      integral(c) = h * (k[0] + h * (k[1] / 2.0 + h * (k[2] / 3.0 + h * k[3] / 4.0)));
+    }
+    const Vector3d displacement = env.PositionErrorNed(samples[i + 1].llh, samples[i].llh);
+    const double mismatch = (displacement - integral).norm();
+    const double allowed = 10.0 + 0.1 * std::max(displacement.norm(), integral.norm());
+    if (!(mismatch <= allowed)) {
+      RejectText(motion.field_path + ".truth_profile[" + std::to_string(i + 1) + "]",
+                 "its position is " + CompactText(displacement.norm()) +
+                     " m from the previous sample's, the velocities integrate to " +
+                     CompactText(integral.norm()) + " m (they disagree by " +
+                     CompactText(mismatch) + " m); allowed: a disagreement of at most " +
+                     CompactText(allowed) +
+                     " m (10 m + 10 %): positions after the first sample are integrated from the "
+                     "velocities");
+    }
   }
 }
 
