@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "driftlab/app/result_check.h"
+#include "driftlab/app/result_file.h"
 #include "driftlab/ins_gnss_filter.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/units.h"
@@ -233,6 +234,7 @@ v1::JobResult ToJobResult(const v1::Job& job_as_run, const MonteCarloStatistics&
                                        data.timings.wall_s
                                  : 0.0);
   timings->set_threads(static_cast<uint32_t>(data.timings.threads));
+  CheckResultStatistics(result);
   return result;
 }
 
@@ -242,7 +244,52 @@ v1::JobResult ToJobResult(const v1::Job& job_as_run, const MonteCarloOutput& out
   const std::vector<double>& times = output.statistics.data().epoch_times_s;
   if (output.covariance) SetCovariance(*output.covariance, times, &result);
   if (output.consistency) SetConsistency(*output.consistency, times, &result);
+  CheckResultStatistics(result);
   return result;
+}
+
+void CheckResultStatistics(const v1::JobResult& result) {
+  const auto refuse = [](const std::string& path, double value, const std::string& allowed) {
+    throw SpecError("result",
+                    fmt::format("{}: {} is not allowed; allowed: {} (a result with a non-finite "
+                                "statistic is neither written nor stored)",
+                                path, value, allowed),
+                    0);
+  };
+  try {
+    ValidateJobResult(result);
+  } catch (const SpecError& e) {
+    throw SpecError("result",
+                    std::string(e.what()) +
+                        " (a result with a non-finite statistic is neither written nor stored)",
+                    0);
+  }
+  for (int e = 0; e < result.covariance().epochs_size(); ++e) {
+    const v1::PredictedEpoch& epoch = result.covariance().epochs(e);
+    for (int c = 0; c < epoch.sigma_size(); ++c) {
+      if (!(std::isfinite(epoch.sigma(c)) && epoch.sigma(c) >= 0.0)) {
+        refuse(fmt::format("covariance.epochs[{}].sigma[{}]", e, c), epoch.sigma(c),
+               "a finite sigma >= 0");
+      }
+    }
+  }
+  const v1::FilterConsistency& nees = result.filter_consistency();
+  for (int e = 0; e < nees.epochs_size(); ++e) {
+    const v1::NeesEpoch& epoch = nees.epochs(e);
+    const std::string path = fmt::format("filter_consistency.epochs[{}]", e);
+    if (epoch.has_average_nees() && !std::isfinite(epoch.average_nees())) {
+      refuse(path + ".average_nees", epoch.average_nees(), "a finite number");
+    }
+    if (epoch.has_chi2_95_low() && !std::isfinite(epoch.chi2_95_low())) {
+      refuse(path + ".chi2_95_low", epoch.chi2_95_low(), "a finite number");
+    }
+    if (epoch.has_chi2_95_high() && !std::isfinite(epoch.chi2_95_high())) {
+      refuse(path + ".chi2_95_high", epoch.chi2_95_high(), "a finite number");
+    }
+  }
+  if (nees.has_mean_average_nees() && !std::isfinite(nees.mean_average_nees())) {
+    refuse("filter_consistency.mean_average_nees", nees.mean_average_nees(), "a finite number");
+  }
 }
 
 MonteCarloStatistics StatisticsFromJobResult(const v1::JobResult& result,
@@ -351,6 +398,7 @@ v1::JobResult MergeJobResults(const std::vector<v1::JobResult>& shards,
     cpu_s += shard.timings().cpu_s();
   }
   if (all_cpu) result.mutable_timings()->set_cpu_s(cpu_s);
+  CheckResultStatistics(result);
   return result;
 }
 
