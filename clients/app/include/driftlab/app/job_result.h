@@ -31,9 +31,11 @@ v1::JobResult ToJobResult(const v1::Job& job_as_run, const MonteCarloOutput& out
                           const std::string& engine_version, double cpu_s = -1.0);
 
 // The last check before a result is written (`run`, `merge`) or stored (the server): every
-// statistic finite where ValidateJobResult (result_file.h) requires it, every predicted sigma of
-// the covariance analysis finite and >= 0, every average NEES and its bounds finite. Throws
-// SpecError("result", "<path>: NaN is not allowed; ...").
+// statistic the result holds finite (epochs, checkpoint summaries and per-run values, whichever
+// are present: a shard's partial statistics pass; the sample sigma and its interval may be NaN
+// for one run, result.proto), every predicted sigma of the covariance analysis finite and >= 0,
+// every average NEES and its bounds finite. The result's structure is ValidateJobResult's
+// (result_file.h). Throws SpecError("result", "<path>: nan is not allowed; ...").
 void CheckResultStatistics(const v1::JobResult& result);
 
 // Fills each checkpoint's percentiles, CEP50/95, 2DRMS and maxima from its per-run values.
