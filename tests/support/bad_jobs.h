@@ -26,6 +26,11 @@ inline std::string SmallDriveJob(const std::string& navigation, const std::strin
 }
 
 inline const char* kEkf = R"({"filter": "INS_GNSS_EKF"})";
+// The EKF propagating every 5 samples (0.25 s at 20 Hz): the tactical preset's flicker design has
+// its shortest Gauss-Markov state at bias_instability_tau_min_s / 4 = 0.25 s, which the validator
+// requires to be at least the propagation interval (the default 10 samples, 0.5 s, is refused).
+inline const char* kEkfTactical = R"({"filter": "INS_GNSS_EKF",
+                                      "ekf": {"propagation_step_samples": 5}})";
 inline const char* kGnss = R"({"gnss": {"rate_hz": 1}})";
 
 struct BadJob {
@@ -58,7 +63,7 @@ inline std::vector<BadJob> ValidatedThenFailedJobs() {
       // The GNSS position Gauss-Markov error at tau = 1e-6 s: the filter's GNSS error states blew
       // up.
       {"GnssGaussMarkovTauFarBelowTheFilterStep",
-       SmallDriveJob(kEkf,
+       SmallDriveJob(kEkfTactical,
                      R"({"gnss": {"rate_hz": 1, "position_gauss_markov_sigma_ned_m": [1, 1, 2],
                                          "position_gauss_markov_tau_s": 1e-6}})"),
        "aiding.gnss.position_gauss_markov_tau_s", "1e-06 s"},
@@ -66,7 +71,8 @@ inline std::vector<BadJob> ValidatedThenFailedJobs() {
       // step and the filter discarded the barometer (final down sigma 0.43 m, as without it; the
       // white noise it is gives 0.11 m), with exit status 0.
       {"BarometerBiasTauFarBelowTheFilterStep",
-       SmallDriveJob(kEkf, R"({"gnss": {"rate_hz": 1}, "barometer": {"bias_gauss_markov_sigma_m": 1,
+       SmallDriveJob(kEkfTactical,
+                     R"({"gnss": {"rate_hz": 1}, "barometer": {"bias_gauss_markov_sigma_m": 1,
                                          "bias_gauss_markov_tau_s": 1e-6}})"),
        "aiding.barometer.bias_gauss_markov_tau_s", "1e-06 s"},
       // The model the filter assumes (a mistuned filter) with a tau far below its step.
