@@ -16,29 +16,31 @@
 namespace {
 
 namespace fs = std::filesystem;
-using driftlab::testing::BadJob;
+// driftlab::testing::BadJob, by another name: cli_test.cc has a BadJob of its own (unity builds).
+using EntryBadJob = driftlab::testing::BadJob;
 using driftlab::testing::Result;
 using driftlab::testing::RunDriftlab;
 using driftlab::testing::Scratch;
 
-fs::path Write(const Scratch& scratch, const std::string& name, const std::string& content) {
+fs::path WriteScratchFile(const Scratch& scratch, const std::string& name,
+                          const std::string& content) {
   const fs::path path = scratch.dir() / name;
   std::ofstream(path, std::ios::binary) << content;
   return path;
 }
 
-int Lines(const std::string& text) {
+int MessageLines(const std::string& text) {
   return static_cast<int>(std::count(text.begin(), text.end(), '\n'));
 }
 
 // Every entry refuses `bad` before any work with the same message; no output appears.
-void ExpectRefusedEverywhere(const BadJob& bad) {
+void ExpectRefusedEverywhere(const EntryBadJob& bad) {
   SCOPED_TRACE(bad.name);
   Scratch scratch;
-  const fs::path job = Write(scratch, "job.json", bad.json);
+  const fs::path job = WriteScratchFile(scratch, "job.json", bad.json);
   const Result validate = RunDriftlab({"validate", job.string()}, scratch);
   ASSERT_EQ(validate.exit_status, 2) << validate.out << validate.err;
-  ASSERT_EQ(Lines(validate.err), 1) << validate.err;
+  ASSERT_EQ(MessageLines(validate.err), 1) << validate.err;
   EXPECT_EQ(validate.err.rfind("error: " + bad.field + ": ", 0), 0u) << validate.err;
   EXPECT_NE(validate.err.find(bad.value), std::string::npos) << validate.err;
 
@@ -67,24 +69,25 @@ void ExpectRefusedEverywhere(const BadJob& bad) {
 }
 
 TEST(JobValidationCli, JobsThatValidatedThenFailedAreRefusedByEveryEntry) {
-  for (const BadJob& bad : driftlab::testing::ValidatedThenFailedJobs()) {
+  for (const EntryBadJob& bad : driftlab::testing::ValidatedThenFailedJobs()) {
     ExpectRefusedEverywhere(bad);
   }
 }
 
 TEST(JobValidationCli, MessagesNameFieldsOfTheJobSchema) {
-  for (const BadJob& bad : driftlab::testing::WrongFieldNameJobs()) ExpectRefusedEverywhere(bad);
+  for (const EntryBadJob& bad : driftlab::testing::WrongFieldNameJobs())
+    ExpectRefusedEverywhere(bad);
 }
 
 TEST(JobValidationCli, ImportedMotionErrorsNameTheFileField) {
   // A truth profile of two samples 0.01 s apart: shorter than one 20 Hz interval. The engine once
   // named "motion.segments", a field this job does not have.
   Scratch scratch;
-  Write(scratch, "short.csv", "0,45,7,200,0,0,0,0,0,0\n0.01,45,7,200,0,0,0,0,0,0\n");
-  const BadJob bad{"TruthProfileTooShort",
-                   R"({"rate_hz": 20, "motion": {"truth_profile_file": {"path": ")" +
-                       (scratch.dir() / "short.csv").string() + R"("}}})",
-                   "motion.truth_profile_file.path", "short.csv"};
+  WriteScratchFile(scratch, "short.csv", "0,45,7,200,0,0,0,0,0,0\n0.01,45,7,200,0,0,0,0,0,0\n");
+  const EntryBadJob bad{"TruthProfileTooShort",
+                        R"({"rate_hz": 20, "motion": {"truth_profile_file": {"path": ")" +
+                            (scratch.dir() / "short.csv").string() + R"("}}})",
+                        "motion.truth_profile_file.path", "short.csv"};
   ExpectRefusedEverywhere(bad);
 }
 
@@ -92,7 +95,8 @@ TEST(JobValidationCli, AllanFitOnTooFewSamplesNamesTheData) {
   // Three samples give the Allan deviation at one averaging time; the fit was refused naming
   // noise_fit.flicker_tau_min_s, an option the user never gave.
   Scratch scratch;
-  const fs::path data = Write(scratch, "three.csv", "gyro_x_rad_per_s\n0.001\n-0.002\n0.0005\n");
+  const fs::path data =
+      WriteScratchFile(scratch, "three.csv", "gyro_x_rad_per_s\n0.001\n-0.002\n0.0005\n");
   const Result r =
       RunDriftlab({"allan", data.string(), "--rate", "100", "--columns", "gyro_x_rad_per_s",
                    "--fit", "--out", (scratch.dir() / "m.json").string()},
