@@ -18,8 +18,8 @@ namespace driftlab::fuzz {
 
 using FuzzFunction = void (*)(const uint8_t* data, size_t size);
 
-// Job files: ParseJobJson / ParseJobYaml, then the full validation of `validate` (ValidateJob)
-// and of `run` (ToMonteCarloSpec with its memory estimate).
+// Job files: ParseJobJson / ParseJobYaml, then ValidateJob, the validation of every entry
+// (`validate`, `run`, `simulate`, `export`, the server), with its memory estimate.
 void FuzzJobJson(const uint8_t* data, size_t size);
 void FuzzJobYaml(const uint8_t* data, size_t size);
 // The units parser: ParseUnit, ParseQuantity against every dimension, FromSi, FormatQuantity.

@@ -5,9 +5,9 @@
 
 namespace driftlab::fuzz {
 
-// What `validate` and `run` do with a parsed job: ValidateJob (motion files relative to a
-// directory that does not exist), then ToMonteCarloSpec with the default limits. SpecError
-// (LimitError included) is the expected refusal and is caught.
+// What every entry does with a parsed job: ValidateJob (motion files relative to a directory that
+// does not exist) with the default limits. SpecError (LimitError included) is the expected
+// refusal and is caught.
 void ValidateParsedJob(const v1::Job& job);
 
 }  // namespace driftlab::fuzz

@@ -229,6 +229,7 @@ int RunAllan(const AllanCliOptions& options) {
     if (options.points_per_octave < 1 || options.points_per_octave > 64) {
       throw SpecError("--points-per-octave", std::to_string(options.points_per_octave), "1 to 64");
     }
+    CheckCommandOutputs({{options.data_path, "DATA"}}, {{options.out_path, "--out"}});
     const std::vector<Column> columns = ReadColumns(options);
     pb::Struct& s = *report.mutable_struct_value();
     Set(s, "file", JsonText(options.data_path));

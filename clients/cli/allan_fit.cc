@@ -41,6 +41,10 @@ int RunAllanFit(const AllanFitOptions& options) {
     if (options.points_per_octave < 1 || options.points_per_octave > 64) {
       throw SpecError("--points-per-octave", std::to_string(options.points_per_octave), "1 to 64");
     }
+    CheckCommandOutputs({{options.data_path, "DATA"}, {options.datasheet_path, "--datasheet"}},
+                        {{options.out_path, "--out"},
+                         {options.fit_json_path, "--fit-json"},
+                         {options.report_path, "--report"}});
     app::NoiseFitSettings settings;
     settings.rate_hz = options.rate_hz;
     settings.bias_model = options.bias_model;

@@ -51,6 +51,8 @@ int RunCalibrate(CalibrateOptions o) {
   v1::CalibrationResult result;
   app::NumericTable table;
   try {
+    CheckCommandOutputs({{o.data_path, "DATA"}},
+                        {{o.out_path, "--out"}, {o.report_path, "--report"}});
     o.settings.data_name = o.data_path;
     table = app::ReadNumericCsv(o.data_path);
     if (o.remote.server.empty()) {

@@ -12,6 +12,8 @@
 #include <string_view>
 #include <vector>
 
+#include "driftlab/output_files.h"
+
 namespace driftlab::cli {
 
 // Exit statuses shared by every command.
@@ -37,9 +39,15 @@ std::vector<CommandEntry>& CommandRegistry();
 // stderr. Every command's file output goes through it.
 int WriteOutputText(const std::string& path, std::string_view text, const std::string& option);
 
-// Refuses an output path before the work starts (CheckOutputPath): prints the error and returns
-// false when `path` exists and is not a regular file or its directory does not exist.
-bool OutputPathUsable(const std::string& path, const std::string& option);
+// The checks of a command's output files before its work starts (DESIGN.md invariant 10): no
+// output names one of the command's inputs or another of its outputs (CheckOutputsApart: by
+// device and inode, whatever the spelling or link), each is a new file or a regular file to
+// replace (CheckOutputPath), and its directory takes new files (CheckOutputWritable; with
+// `creates_directories`, for writers that create missing directories, the nearest existing
+// ancestor). Entries with an empty path (an option not given) are skipped. Throws SpecError naming
+// the output's option (exit status 2).
+void CheckCommandOutputs(const std::vector<CommandPath>& inputs,
+                         const std::vector<CommandPath>& outputs, bool creates_directories = false);
 
 // Unsigned integer options parsed strictly (CLI11 would wrap "-1" or 2^64 to 2^64 - 1 and skip an
 // empty value): decimal digits only, within [min, max]; anything else is a one-line error naming

@@ -23,6 +23,7 @@ namespace {
 int RunDatasheet(const std::string& path, const std::string& out_path) {
   std::string json;
   try {
+    CheckCommandOutputs({{path, "FILE"}}, {{out_path, "--out"}});
     const calib::DatasheetModel d = calib::LoadDatasheet(path);
     fmt::print("model {}: {}\n", d.model.name, d.model.description);
     fmt::print("  {:<32} {:<24} {:<24} {}\n", "key", "datasheet", "SI", "model field");

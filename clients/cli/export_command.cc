@@ -3,7 +3,9 @@
 // users who bring their own navigation algorithm: imu.csv (measured increments and point samples),
 // imu_ideal.csv (the error-free data), truth.csv (the reference trajectory), truth_groves.csv (the
 // same in Groves' profile layout) and run.txt (what was run). The job is validated completely
-// before DIR is created.
+// (ValidateJob) and DIR checked before the work (the files it will hold are none of the inputs; it
+// takes new files); the files are written as a set (output_dir.h), so an error or Ctrl-C (exit
+// status 130) leaves neither temporary files nor an incomplete set.
 //
 // With `--server ADDR [--token T] [--tls-ca F]` the server simulates the run (Datasets.ExportRun)
 // and streams it: imu.csv and truth.csv (the same columns and numbers as the local files: the
@@ -11,7 +13,6 @@
 // navigation.csv with --navigation (the engine's own navigation solution of that run, the layout
 // `driftlab score` reads) and run.txt.
 #include <fmt/format.h>
-#include <fmt/os.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -24,13 +25,16 @@
 
 #include "commands.h"
 #include "driftlab/app/job_file.h"
-#include "driftlab/app/monte_carlo_job.h"
+#include "driftlab/app/job_validator.h"
 #include "driftlab/app/sensor_model.h"
 #include "driftlab/app/translate.h"
 #include "driftlab/io.h"
 #include "driftlab/monte_carlo.h"
 #include "driftlab/simulate.h"
 #include "driftlab/spec_error.h"
+#include "interrupt.h"
+#include "output_dir.h"
+#include "remote.h"
 #include "remote_client.h"
 
 namespace driftlab::cli {
@@ -79,15 +83,31 @@ void CheckColumns(const google::protobuf::RepeatedPtrField<std::string>& columns
   }
 }
 
+// Thrown when Ctrl-C (SIGINT) or SIGTERM arrived.
+struct Interrupted {};
+
+// The files the job names (the job file and its motion file), which the export must not replace.
+std::vector<CommandPath> JobInputs(const std::string& job_path, const app::JobFile& file) {
+  std::vector<CommandPath> inputs = {{job_path, "JOB"}};
+  for (const CommandPath& p : app::JobInputFiles(file.job, file.base_dir)) inputs.push_back(p);
+  return inputs;
+}
+
 int RunRemoteExport(const ExportOptions& options) {
   v1::ExportRunRequest request;
   std::unique_ptr<v1::Datasets::Stub> stub;
+  std::optional<OutputDirectory> out;
   try {
     v1::RunRef* run = request.mutable_run();
-    *run->mutable_job() = app::LoadJobFile(options.job_path).job;
+    const app::JobFile file = app::LoadJobFile(options.job_path);
+    *run->mutable_job() = file.job;
     if (options.seed) run->set_seed(*options.seed);
     run->set_run_index(options.run_index);
     request.set_include_navigation(options.navigation);
+    std::vector<std::string> names = {"imu.csv", "truth.csv", "run.txt"};
+    if (options.navigation) names.push_back("navigation.csv");
+    std::vector<CommandPath> inputs = {{options.job_path, "JOB"}};
+    out.emplace(options.out_dir, "--out", names, inputs);
     stub = v1::Datasets::NewStub(MakeChannel(options.remote));
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
@@ -97,6 +117,8 @@ int RunRemoteExport(const ExportOptions& options) {
 
   grpc::ClientContext context;
   PrepareContext(options.remote, &context);
+  // Ctrl-C cancels the stream; the files written so far are removed below.
+  InterruptWatch interrupt([&context] { context.TryCancel(); });
   std::unique_ptr<grpc::ClientReader<v1::ExportRunResponse>> reader =
       stub->ExportRun(&context, request);
   const std::filesystem::path dir(options.out_dir);
@@ -111,17 +133,17 @@ int RunRemoteExport(const ExportOptions& options) {
         CheckColumns(header->imu_columns(), "IMU");
         CheckColumns(header->truth_columns(), "truth");
         if (options.navigation) CheckColumns(header->navigation_columns(), "navigation");
-        std::filesystem::create_directories(dir);
         const std::vector<std::string> imu_columns(header->imu_columns().begin(),
                                                    header->imu_columns().end());
         const std::vector<std::string> truth_columns(header->truth_columns().begin(),
                                                      header->truth_columns().end());
-        imu = std::make_unique<RowsCsvWriter>(dir / "imu.csv", imu_columns);
-        truth = std::make_unique<RowsCsvWriter>(dir / "truth.csv", truth_columns);
+        imu = std::make_unique<RowsCsvWriter>(out->Path("imu.csv"), imu_columns);
+        truth = std::make_unique<RowsCsvWriter>(out->Path("truth.csv"), truth_columns);
         if (options.navigation) {
           const std::vector<std::string> navigation_columns(header->navigation_columns().begin(),
                                                             header->navigation_columns().end());
-          navigation = std::make_unique<RowsCsvWriter>(dir / "navigation.csv", navigation_columns);
+          navigation =
+              std::make_unique<RowsCsvWriter>(out->Path("navigation.csv"), navigation_columns);
         }
         continue;
       }
@@ -138,11 +160,29 @@ int RunRemoteExport(const ExportOptions& options) {
   } catch (const std::exception& e) {
     context.TryCancel();
     reader->Finish();
+    imu.reset();
+    truth.reset();
+    navigation.reset();
+    out.reset();
     fmt::print(stderr, "error: {}: {}\n", options.remote.server, e.what());
     return kExitFailure;
   }
   const grpc::Status status = reader->Finish();
-  if (!status.ok()) return ReportRpcError(status, options.remote);
+  if (interrupt.interrupted()) {
+    imu.reset();
+    truth.reset();
+    navigation.reset();
+    out.reset();
+    fmt::print(stderr, "cancelled: nothing written\n");
+    return kExitCancelled;
+  }
+  if (!status.ok()) {
+    imu.reset();
+    truth.reset();
+    navigation.reset();
+    out.reset();
+    return ReportRpcError(status, options.remote);
+  }
   try {
     if (!header) throw std::runtime_error("the export stream ended without a header");
     auto check_rows = [](const RowsCsvWriter& writer, uint64_t expected, const char* name) {
@@ -159,14 +199,18 @@ int RunRemoteExport(const ExportOptions& options) {
       check_rows(*navigation, header->navigation_rows(), "navigation.csv");
       navigation->Close();
     }
-    {
-      auto run = fmt::output_file((dir / "run.txt").string());
-      run.print("job: {}\nname: {}\nserver: {}\nseed: {}\nrun: {}\nrate_hz: {:.17g}\n",
-                options.job_path, request.run().job().name(), options.remote.server, seed,
-                options.run_index, header->rate_hz());
-      run.print("samples: {}\n", header->imu_rows());
-    }
+    WriteOutputFile(out->Path("run.txt"),
+                    fmt::format("job: {}\nname: {}\nserver: {}\nseed: {}\nrun: {}\n"
+                                "rate_hz: {:.17g}\nsamples: {}\n",
+                                options.job_path, request.run().job().name(), options.remote.server,
+                                seed, options.run_index, header->rate_hz(), header->imu_rows()),
+                    "--out");
+    out->Commit();
   } catch (const std::exception& e) {
+    imu.reset();
+    truth.reset();
+    navigation.reset();
+    out.reset();
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitFailure;
   }
@@ -180,13 +224,16 @@ int RunRemoteExport(const ExportOptions& options) {
 
 int RunExport(const ExportOptions& options) {
   if (!options.remote.server.empty()) return RunRemoteExport(options);
+  // From here on Ctrl-C ends the command through the cleanup below, not by the default action.
+  InterruptWatch interrupt([] {});
   app::JobFile file;
   MonteCarloSpec spec;
+  std::optional<OutputDirectory> out;
   try {
     file = app::LoadJobFile(options.job_path);
-    app::MonteCarloOverrides overrides;
-    overrides.seed = options.seed;
-    spec = app::ToMonteCarloSpec(file, overrides);
+    app::JobValidationOptions validation;
+    validation.overrides.seed = options.seed;
+    spec = app::ValidateJob(file, validation).spec;
     if (!spec.sensor) {
       throw SpecError("sensor", "(absent)",
                       "a sensor model (preset or parameters): export writes errored IMU data; "
@@ -197,49 +244,57 @@ int RunExport(const ExportOptions& options) {
                       "< monte_carlo.runs = " + std::to_string(spec.runs) +
                           " (run R of the job's Monte Carlo)");
     }
+    out.emplace(options.out_dir, "--out",
+                std::vector<std::string>{"truth.csv", "truth_groves.csv", "imu.csv",
+                                         "imu_ideal.csv", "run.txt"},
+                JobInputs(options.job_path, file));
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;
   }
 
   const std::filesystem::path dir(options.out_dir);
-  std::error_code error;
-  std::filesystem::create_directories(dir, error);
-  if (error) {
-    fmt::print(stderr, "error: {}: cannot create the output directory ({})\n", options.out_dir,
-               error.message());
-    return kExitFailure;
-  }
   try {
-    TruthCsvWriter truth(dir / "truth.csv");
-    GrovesProfileWriter groves(dir / "truth_groves.csv");
-    ImuCsvWriter imu(dir / "imu.csv");
-    ImuCsvWriter imu_ideal(dir / "imu_ideal.csv");
-    const SimulationSummary summary = SimulateMonteCarloRun(
-        spec, options.run_index, [&](const SimulationStep& step, const InsGnssFilter*) {
-          const double t_s = step.truth->t_s;
-          truth.Write(*step.truth);
-          groves.Write(*step.truth);
-          imu.Write(t_s, *step.measured_increment, *step.measured_sample);
-          imu_ideal.Write(t_s, *step.increment, *step.sample);
-        });
-    truth.Close();
-    groves.Close();
-    imu.Close();
-    imu_ideal.Close();
+    if (interrupt.interrupted()) throw Interrupted{};
+    SimulationSummary summary;
     {
-      auto run = fmt::output_file((dir / "run.txt").string());
-      run.print("job: {}\nname: {}\nsensor model: {}\nseed: {}\nrun: {}\nrate_hz: {:.17g}\n",
-                options.job_path, file.job.name(), spec.sensor->name, spec.seed, options.run_index,
-                spec.simulation.rate_hz);
-      run.print("samples: {}\nduration_s: {:.17g}\n", summary.steps + 1, summary.duration_s);
+      TruthCsvWriter truth(out->Path("truth.csv"));
+      GrovesProfileWriter groves(out->Path("truth_groves.csv"));
+      ImuCsvWriter imu(out->Path("imu.csv"));
+      ImuCsvWriter imu_ideal(out->Path("imu_ideal.csv"));
+      summary = SimulateMonteCarloRun(
+          spec, options.run_index, [&](const SimulationStep& step, const InsGnssFilter*) {
+            if (interrupt.interrupted()) throw Interrupted{};
+            const double t_s = step.truth->t_s;
+            truth.Write(*step.truth);
+            groves.Write(*step.truth);
+            imu.Write(t_s, *step.measured_increment, *step.measured_sample);
+            imu_ideal.Write(t_s, *step.increment, *step.sample);
+          });
+      truth.Close();
+      groves.Close();
+      imu.Close();
+      imu_ideal.Close();
     }
+    WriteOutputFile(
+        out->Path("run.txt"),
+        fmt::format("job: {}\nname: {}\nsensor model: {}\nseed: {}\nrun: {}\nrate_hz: {:.17g}\n"
+                    "samples: {}\nduration_s: {:.17g}\n",
+                    options.job_path, file.job.name(), spec.sensor->name, spec.seed,
+                    options.run_index, spec.simulation.rate_hz, summary.steps + 1,
+                    summary.duration_s),
+        "--out");
+    out->Commit();
     fmt::print("{}: sensor model {}, seed {}, run {}: {} samples at {:g} Hz ({:.3f} s)\n",
                file.job.name().empty() ? "(unnamed)" : file.job.name(), spec.sensor->name,
                spec.seed, options.run_index, summary.steps + 1, spec.simulation.rate_hz,
                summary.duration_s);
     fmt::print("wrote imu.csv, imu_ideal.csv, truth.csv, truth_groves.csv, run.txt to {}\n",
                dir.string());
+  } catch (const Interrupted&) {
+    out.reset();  // removes the files written so far
+    fmt::print(stderr, "cancelled: nothing written\n");
+    return kExitCancelled;
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;

@@ -88,6 +88,10 @@ int PrintRunsForChange(const v1::JobResult& result, const std::vector<app::GateR
 int RunGateCommand(const GateOptions& options) {
   app::GateReport report;
   try {
+    CheckCommandOutputs({{options.result_path, "RESULT"},
+                         {options.baseline_path, "--baseline"},
+                         {options.rules_path, "--rules"}},
+                        {{options.junit_path, "--junit"}});
     const v1::JobResult current = app::ReadJobResult(options.result_path);
     app::VerifyResultStatistics(current, options.result_path);
     if (options.list_metrics) {

@@ -47,14 +47,21 @@ uint64_t MemoryLimitBytes(double gigabytes) {
   return static_cast<uint64_t>(gigabytes * 1e9);
 }
 
-bool OutputPathUsable(const std::string& path, const std::string& option) {
-  try {
-    CheckOutputPath(path, option);
-  } catch (const SpecError& e) {
-    fmt::print(stderr, "error: {}\n", e.what());
-    return false;
+void CheckCommandOutputs(const std::vector<CommandPath>& inputs,
+                         const std::vector<CommandPath>& outputs, bool creates_directories) {
+  const auto given = [](const std::vector<CommandPath>& paths) {
+    std::vector<CommandPath> out;
+    for (const CommandPath& p : paths) {
+      if (!p.path.empty()) out.push_back(p);
+    }
+    return out;
+  };
+  const std::vector<CommandPath> given_outputs = given(outputs);
+  CheckOutputsApart(given(inputs), given_outputs);
+  for (const CommandPath& output : given_outputs) {
+    CheckOutputPath(output.path, output.option);
+    CheckOutputWritable(output.path, output.option, creates_directories);
   }
-  return true;
 }
 
 }  // namespace driftlab::cli

@@ -260,6 +260,9 @@ int RunRemoteJob(const RemoteOptions& options, const RemoteRunRequest& run) {
   v1::SubmitJobRequest request;
   std::shared_ptr<grpc::Channel> channel;
   try {
+    CheckCommandOutputs({{run.job_path, "JOB"}},
+                        {{run.out, "--out"}, {run.report.value_or(""), "--report"}},
+                        /*creates_directories=*/true);
     *request.mutable_job() = app::LoadJobFile(run.job_path).job;
     if (run.covariance) request.mutable_job()->mutable_monte_carlo()->set_covariance(true);
     channel = MakeChannel(options);

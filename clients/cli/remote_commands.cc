@@ -150,6 +150,13 @@ struct ResultOptions {
 };
 
 int RunResult(const ResultOptions& options) {
+  try {
+    CheckCommandOutputs({}, {{options.out, "--out"}, {options.report.value_or(""), "--report"}},
+                        /*creates_directories=*/true);
+  } catch (const SpecError& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    return kExitBadJob;
+  }
   JobsClient client = ConnectJobs(options.remote);
   if (client.error != kExitOk) return client.error;
   grpc::ClientContext context;
@@ -214,6 +221,9 @@ int RunScore(const ScoreOptions& options) {
   app::NumericTable table;
   std::unique_ptr<v1::Datasets::Stub> stub;
   try {
+    CheckCommandOutputs({{options.job_path, "JOB"}, {options.solution_path, "SOLUTION"}},
+                        {{options.out, "--out"}, {options.report.value_or(""), "--report"}},
+                        /*creates_directories=*/true);
     v1::RunRef* run = header.mutable_header()->mutable_run();
     *run->mutable_job() = app::LoadJobFile(options.job_path).job;
     if (options.seed) run->set_seed(*options.seed);

@@ -58,6 +58,7 @@ std::string Render(const std::string& path) {
 int RunReport(const ReportOptions& options) {
   std::string html;
   try {
+    CheckCommandOutputs({{options.result_path, "RESULT"}}, {{options.out_path, "--out"}});
     html = Render(options.result_path);
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());

@@ -28,8 +28,10 @@
 #include "commands.h"
 #include "driftlab/app/consistency_check.h"
 #include "driftlab/app/job_file.h"
+#include "driftlab/app/job_validator.h"
 #include "driftlab/app/monte_carlo_job.h"
 #include "driftlab/app/result_file.h"
+#include "driftlab/app/translate.h"
 #include "driftlab/monte_carlo.h"
 #include "driftlab/output_files.h"
 #include "driftlab/report/html_report.h"
@@ -180,7 +182,8 @@ int RunRun(const RunOptions& options) {
   MonteCarloSpec spec;
   try {
     file = app::LoadJobFile(options.job_path);
-    app::MonteCarloOverrides overrides;
+    app::JobValidationOptions validation;
+    app::MonteCarloOverrides& overrides = validation.overrides;
     overrides.runs = options.runs;
     overrides.seed = options.seed;
     overrides.threads = options.threads;
@@ -188,11 +191,11 @@ int RunRun(const RunOptions& options) {
     if (options.max_memory_gb)
       overrides.max_memory_bytes = MemoryLimitBytes(*options.max_memory_gb);
     if (options.shard) app::ParseShard(*options.shard, &overrides);
-    if (!OutputPathUsable(options.out, "--out") ||
-        (options.report && !OutputPathUsable(*options.report, "--report"))) {
-      return kExitBadJob;
-    }
-    spec = app::ToMonteCarloSpec(file, overrides);
+    std::vector<CommandPath> inputs = {{options.job_path, "JOB"}};
+    for (const CommandPath& p : app::JobInputFiles(file.job, file.base_dir)) inputs.push_back(p);
+    CheckCommandOutputs(inputs, {{options.out, "--out"}, {options.report.value_or(""), "--report"}},
+                        /*creates_directories=*/true);
+    spec = app::ValidateJob(file, validation).spec;
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;
@@ -241,6 +244,10 @@ int RunMerge(const MergeOptions& options) {
   std::vector<v1::JobResult> shards;
   v1::JobResult result;
   try {
+    std::vector<CommandPath> inputs;
+    for (const std::string& path : options.shards) inputs.push_back({path, "SHARD"});
+    CheckCommandOutputs(inputs, {{options.out, "--out"}, {options.report.value_or(""), "--report"}},
+                        /*creates_directories=*/true);
     for (const std::string& path : options.shards) shards.push_back(app::ReadJobResult(path));
     result = app::MergeJobResults(shards, options.shards, DRIFTLAB_VERSION);
   } catch (const SpecError& e) {

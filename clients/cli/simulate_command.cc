@@ -3,8 +3,10 @@
 // sensor errors, initial errors, alignment, aiding and filter): truth.csv, imu.csv, imu_ideal.csv
 // (with a sensor model), nav.csv and errors.csv (from the navigation start on) and, for the
 // INS/GNSS EKF, filter.csv (its sensor-error estimates and the 1-sigma of its navigation errors).
-// The job is validated completely (fields and the planned motion) before DIR is created, so a bad
-// job writes nothing.
+// The job is validated completely (ValidateJob) and DIR checked (the files it will hold are none of
+// the inputs, it takes new files) before the work, so a bad job or output writes nothing; the files
+// are written as a set (output_dir.h), so an error or Ctrl-C leaves neither temporary files nor an
+// incomplete set (exit status 130 on Ctrl-C).
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -15,17 +17,20 @@
 #include <optional>
 #include <string>
 #include <system_error>
+#include <vector>
 
 #include "commands.h"
 #include "driftlab/app/job_file.h"
-#include "driftlab/app/monte_carlo_job.h"
-#include "driftlab/app/sensor_model.h"
+#include "driftlab/app/job_validator.h"
 #include "driftlab/app/translate.h"
 #include "driftlab/io.h"
 #include "driftlab/monte_carlo.h"
 #include "driftlab/simulate.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/units.h"
+#include "interrupt.h"
+#include "output_dir.h"
+#include "remote.h"
 
 namespace driftlab::cli {
 namespace {
@@ -97,46 +102,61 @@ struct SimulateOptions {
   uint32_t run_index = 0;
 };
 
+// Thrown from the step callback when Ctrl-C (SIGINT) or SIGTERM arrived.
+struct Interrupted {};
+
 int RunSimulate(const SimulateOptions& options) {
-  const std::string& out_dir = options.out_dir;
+  // From here on Ctrl-C ends the command through the cleanup below, not by the default action.
+  InterruptWatch interrupt([] {});
   app::JobFile file;
   MonteCarloSpec spec;
+  std::optional<OutputDirectory> out;
   try {
     file = app::LoadJobFile(options.job_path);
-    app::MonteCarloOverrides overrides;
-    overrides.seed = options.seed;
-    spec = app::ToMonteCarloSpec(file, overrides);
+    app::JobValidationOptions validation;
+    validation.overrides.seed = options.seed;
+    spec = app::ValidateJob(file, validation).spec;
     if (options.run_index >= spec.runs) {
       throw SpecError("--run", std::to_string(options.run_index),
                       "< monte_carlo.runs = " + std::to_string(spec.runs) +
                           " (run N of the job's Monte Carlo)");
     }
+    std::vector<std::string> names = {"truth.csv", "imu.csv", "nav.csv", "errors.csv"};
+    if (spec.sensor) names.push_back("imu_ideal.csv");
+    if (spec.filter == NavigationFilterKind::kInsGnssEkf) names.push_back("filter.csv");
+    std::vector<CommandPath> inputs = {{options.job_path, "JOB"}};
+    for (const CommandPath& p : app::JobInputFiles(file.job, file.base_dir)) inputs.push_back(p);
+    out.emplace(options.out_dir, "--out", names, inputs);
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;
   }
 
-  const std::filesystem::path dir(out_dir);
-  std::error_code error;
-  std::filesystem::create_directories(dir, error);
-  if (error) {
-    fmt::print(stderr, "error: {}: cannot create the output directory ({})\n", out_dir,
-               error.message());
-    return kExitFailure;
-  }
+  const std::filesystem::path dir(options.out_dir);
   try {
+    if (interrupt.interrupted()) throw Interrupted{};
     const bool ekf = spec.filter == NavigationFilterKind::kInsGnssEkf;
-    SimulationCsvWriters writers(dir, /*ideal_imu=*/spec.sensor.has_value());
-    std::optional<FilterCsvWriter> filter_csv;
-    if (ekf) filter_csv.emplace(dir / "filter.csv");
-    const SimulationSummary summary = SimulateMonteCarloRun(
-        spec, options.run_index, [&](const SimulationStep& step, const InsGnssFilter* filter) {
-          writers.Write(step);
-          if (filter_csv && filter != nullptr) filter_csv->Write(step.truth->t_s, *filter);
-        });
-    writers.Close();
-    if (filter_csv) filter_csv->Close();
+    SimulationSummary summary;
+    {
+      SimulationCsvWriters writers(out->directory(), /*ideal_imu=*/spec.sensor.has_value());
+      std::optional<FilterCsvWriter> filter_csv;
+      if (ekf) filter_csv.emplace(out->Path("filter.csv"));
+      summary = SimulateMonteCarloRun(spec, options.run_index,
+                                      [&](const SimulationStep& step, const InsGnssFilter* filter) {
+                                        if (interrupt.interrupted()) throw Interrupted{};
+                                        writers.Write(step);
+                                        if (filter_csv && filter != nullptr)
+                                          filter_csv->Write(step.truth->t_s, *filter);
+                                      });
+      writers.Close();
+      if (filter_csv) filter_csv->Close();
+    }
+    out->Commit();
     PrintSummary(file, spec, options.run_index, summary, dir, ekf);
+  } catch (const Interrupted&) {
+    out.reset();  // removes the files written so far
+    fmt::print(stderr, "cancelled: nothing written\n");
+    return kExitCancelled;
   } catch (const SpecError& e) {
     // The engine may still reject a job after planning (a check made while integrating).
     fmt::print(stderr, "error: {}\n", e.what());

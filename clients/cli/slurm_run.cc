@@ -14,6 +14,7 @@
 #include "commands.h"
 #include "driftlab/app/job_file.h"
 #include "driftlab/app/monte_carlo_job.h"
+#include "driftlab/app/translate.h"
 #include "driftlab/output_files.h"
 #include "driftlab/slurm/shard_array.h"
 #include "driftlab/spec_error.h"
@@ -44,8 +45,10 @@ int RunOnSlurm(const SlurmRunOptions& options) {
       throw SpecError("--shards", std::to_string(options.shards),
                       fmt::format("1 .. the job's runs ({}), at most 100000", spec.runs));
     }
-    CheckOutputPath(options.out, "--out");
-    if (options.report) CheckOutputPath(*options.report, "--report");
+    std::vector<CommandPath> inputs = {{options.job_path, "JOB"}};
+    for (const CommandPath& p : app::JobInputFiles(file.job, file.base_dir)) inputs.push_back(p);
+    CheckCommandOutputs(inputs, {{options.out, "--out"}, {options.report.value_or(""), "--report"}},
+                        /*creates_directories=*/true);
     work_dir = fs::absolute(options.work_dir.empty() ? options.out + ".slurm" : options.work_dir);
     if (fs::exists(work_dir) && !fs::is_directory(work_dir)) {
       throw SpecError("--slurm-dir", work_dir.string(), "a directory (or a path to create one)");

@@ -1,4 +1,6 @@
-// `driftlab validate JOB`: prints "OK" or the first error of the job (exit 2).
+// `driftlab validate JOB`: prints "OK" or the first error of the job (exit 2). The check is
+// app::ValidateJob, the one every entry (run, simulate, export, the server) makes: a job that
+// validates runs.
 #include <fmt/format.h>
 
 #include <cstdio>
@@ -7,7 +9,7 @@
 
 #include "commands.h"
 #include "driftlab/app/job_file.h"
-#include "driftlab/app/monte_carlo_job.h"
+#include "driftlab/app/job_validator.h"
 #include "driftlab/spec_error.h"
 
 namespace driftlab::cli {
@@ -16,7 +18,7 @@ namespace {
 int RunValidate(const std::string& job_path) {
   try {
     const app::JobFile file = app::LoadJobFile(job_path);
-    app::ToMonteCarloSpec(file, {});  // motion, navigation, sensor and monte_carlo
+    app::ValidateJob(file);
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;

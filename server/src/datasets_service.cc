@@ -2,8 +2,8 @@
 // engine's navigation solution), and an external solution scored against that run's truth.
 //
 // The run is the one a Monte-Carlo job with this seed gives run_index: the job is validated as
-// the CLI does (app::ToMonteCarloSpec on JobFile{job, ""}, file references rejected: the
-// server reads no client-named files) and replayed by the engine (ReplayMonteCarloRun: the same
+// every entry does (app::ValidateJob, file references rejected: the server reads no client-named
+// files) and replayed by the engine (ReplayMonteCarloRun: the same
 // truth, sensor errors, initial errors, alignment and mechanization as RunMonteCarlo). Rows are
 // laid out as dataset_rows.h documents (imu.csv / truth.csv columns of `driftlab export`).
 //
@@ -20,11 +20,11 @@
 #include <vector>
 
 #include "driftlab/app/dataset_rows.h"
+#include "driftlab/app/job_validator.h"
 #include "driftlab/app/monte_carlo_job.h"
 #include "driftlab/monte_carlo.h"
 #include "driftlab/server/data_services.h"
 #include "driftlab/spec_error.h"
-#include "driftlab/trajectory.h"
 
 namespace driftlab::server {
 namespace {
@@ -50,21 +50,12 @@ struct StopReplay {
 // Throws SpecError; returns RESOURCE_EXHAUSTED in *status for a run beyond max_job_samples.
 ResolvedRun ResolveRun(const v1::RunRef& ref, const std::string& field, const ServerLimits& limits,
                        grpc::Status* status) {
-  const v1::Motion& motion = ref.job().motion();
-  if (motion.has_gnss_ins_sim_file()) {
-    throw SpecError("motion.gnss_ins_sim_file.path", motion.gnss_ins_sim_file().path(),
-                    "no file reference: the server does not read files; inline the motion "
-                    "(segments)");
-  }
-  if (motion.has_truth_profile_file()) {
-    throw SpecError("motion.truth_profile_file.path", motion.truth_profile_file().path(),
-                    "no file reference: the server does not read files; inline the motion "
-                    "(segments)");
-  }
-  app::MonteCarloOverrides overrides;
-  if (ref.has_seed()) overrides.seed = ref.seed();
+  app::JobValidationOptions options;
+  if (ref.has_seed()) options.overrides.seed = ref.seed();
+  options.allow_file_references = false;
+  app::ValidatedJob job = app::ValidateJob(ref.job(), "", options);
   ResolvedRun out;
-  out.spec = app::ToMonteCarloSpec(app::JobFile{ref.job(), ""}, overrides);
+  out.spec = std::move(job.spec);
   out.run = ref.has_run_index() ? ref.run_index() : 0;
   if (out.run >= out.spec.runs) {
     throw SpecError(
@@ -74,9 +65,8 @@ ResolvedRun ResolveRun(const v1::RunRef& ref, const std::string& field, const Se
   out.spec.first_run = out.run;
   out.spec.run_count = 1;
   out.job_as_run = app::JobAsRun(ref.job(), out.spec);
-  // Plans the segments only (ToMonteCarloSpec validated them); no samples are generated.
-  out.samples =
-      TrajectoryGenerator(out.spec.simulation.motion, out.spec.simulation.rate_hz).num_steps() + 1;
+  out.samples = static_cast<int64_t>(job.samples_per_run) +
+                (out.spec.simulation.mechanization == MechanizationKind::kSeed000 ? 0 : 1);
   if (static_cast<uint64_t>(out.samples) > limits.max_job_samples) {
     *status = grpc::Status(grpc::StatusCode::RESOURCE_EXHAUSTED,
                            fmt::format("{}: the run has {} IMU samples; the server's limit is {} "

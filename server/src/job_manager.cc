@@ -10,16 +10,14 @@
 #include <limits>
 
 #include "driftlab/app/job_file.h"
+#include "driftlab/app/job_validator.h"
 #include "driftlab/app/monte_carlo_job.h"
 #include "driftlab/spec_error.h"
-#include "driftlab/trajectory.h"
 
 namespace driftlab::server {
 namespace {
 
-using google::protobuf::FieldDescriptor;
 using google::protobuf::Message;
-using google::protobuf::Reflection;
 using SteadyClock = std::chrono::steady_clock;
 
 // Largest accepted deadline_s: one year.
@@ -35,84 +33,7 @@ double UnixNow() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
-std::string FieldPath(const std::string& path, const FieldDescriptor& field, int index) {
-  std::string out = path.empty() ? field.name() : path + "." + field.name();
-  if (index >= 0) out += "[" + std::to_string(index) + "]";
-  return out;
-}
-
-std::string AllowedEnumNames(const google::protobuf::EnumDescriptor& type) {
-  std::string names;
-  for (int i = 0; i < type.value_count(); ++i) {
-    if (i) names += ", ";
-    names += type.value(i)->name();
-  }
-  return names;
-}
-
-void CheckFieldValue(const Message& message, const FieldDescriptor& field, int index,
-                     const std::string& path) {
-  const Reflection& r = *message.GetReflection();
-  const bool repeated = field.is_repeated();
-  switch (field.cpp_type()) {
-    case FieldDescriptor::CPPTYPE_ENUM: {
-      const int value = repeated ? r.GetRepeatedEnumValue(message, &field, index)
-                                 : r.GetEnumValue(message, &field);
-      if (field.enum_type()->FindValueByNumber(value) == nullptr) {
-        throw SpecError(FieldPath(path, field, index), std::to_string(value),
-                        AllowedEnumNames(*field.enum_type()));
-      }
-      break;
-    }
-    case FieldDescriptor::CPPTYPE_DOUBLE:
-    case FieldDescriptor::CPPTYPE_FLOAT: {
-      double value = 0;
-      if (field.cpp_type() == FieldDescriptor::CPPTYPE_DOUBLE) {
-        value =
-            repeated ? r.GetRepeatedDouble(message, &field, index) : r.GetDouble(message, &field);
-      } else {
-        value = repeated ? r.GetRepeatedFloat(message, &field, index) : r.GetFloat(message, &field);
-      }
-      if (!std::isfinite(value)) {
-        throw SpecError(FieldPath(path, field, index),
-                        std::isnan(value) ? "NaN" : (value > 0 ? "Infinity" : "-Infinity"),
-                        "a finite number");
-      }
-      break;
-    }
-    case FieldDescriptor::CPPTYPE_MESSAGE:
-      CheckMessageValues(
-          repeated ? r.GetRepeatedMessage(message, &field, index) : r.GetMessage(message, &field),
-          FieldPath(path, field, index));
-      break;
-    default:
-      break;
-  }
-}
-
 }  // namespace
-
-void CheckMessageValues(const Message& message, const std::string& path) {
-  const Reflection& r = *message.GetReflection();
-  if (!r.GetUnknownFields(message).empty()) {
-    const auto& unknown = r.GetUnknownFields(message);
-    throw SpecError(path.empty() ? "(job)" : path,
-                    "unknown field number " + std::to_string(unknown.field(0).number()),
-                    "the fields of " + message.GetDescriptor()->full_name());
-  }
-  std::vector<const FieldDescriptor*> fields;
-  r.ListFields(message, &fields);  // set fields, in field-number order
-  for (const FieldDescriptor* field : fields) {
-    if (field->is_map()) continue;
-    if (field->is_repeated()) {
-      for (int i = 0; i < r.FieldSize(message, field); ++i) {
-        CheckFieldValue(message, *field, i, path);
-      }
-    } else {
-      CheckFieldValue(message, *field, -1, path);
-    }
-  }
-}
 
 std::string SerializeDeterministic(const Message& message) {
   std::string bytes;
@@ -128,20 +49,6 @@ std::string SerializeDeterministic(const Message& message) {
 ValidatedJob ValidateSubmitRequest(const v1::SubmitJobRequest& request, int threads_per_job,
                                    uint64_t max_memory_bytes) {
   if (!request.has_job()) throw SpecError("job", "", "a job (motion, rate_hz, navigation, ...)");
-  CheckMessageValues(request.job());
-  const v1::Motion& motion = request.job().motion();
-  if (motion.has_gnss_ins_sim_file()) {
-    throw SpecError("motion.gnss_ins_sim_file.path",
-                    "\"" + motion.gnss_ins_sim_file().path() +
-                        "\": the server does not read files; inline the motion",
-                    0);
-  }
-  if (motion.has_truth_profile_file()) {
-    throw SpecError("motion.truth_profile_file.path",
-                    "\"" + motion.truth_profile_file().path() +
-                        "\": the server does not read files; inline the motion",
-                    0);
-  }
   app::MonteCarloOverrides overrides;
   if (request.has_runs()) {
     if (request.runs() < 1 || request.runs() > kMaxMonteCarloRuns) {
@@ -168,17 +75,14 @@ ValidatedJob ValidateSubmitRequest(const v1::SubmitJobRequest& request, int thre
   overrides.threads = threads_per_job;
   overrides.max_memory_bytes = max_memory_bytes;
 
-  app::JobFile file{request.job(), std::filesystem::path()};
+  app::JobValidationOptions options;
+  options.overrides = overrides;
+  options.allow_file_references = false;
+  app::ValidatedJob job = app::ValidateJob(request.job(), std::filesystem::path(), options);
   ValidatedJob out;
-  out.spec = app::ToMonteCarloSpec(file, overrides);
-  const MonteCarloSpec& spec = out.spec;
-  out.runs_total = spec.run_count == 0 ? spec.runs - spec.first_run : spec.run_count;
-  // Samples per run as the engine counts them (monte_carlo.cc): the generator's output steps, plus
-  // the initial sample for mechanization B, which consumes point samples from t = 0.
-  const TrajectoryGenerator generator(spec.simulation.motion, spec.simulation.rate_hz);
-  const uint64_t per_run = static_cast<uint64_t>(generator.num_steps()) +
-                           (spec.simulation.mechanization == MechanizationKind::kSeed000 ? 1 : 0);
-  out.samples_total = per_run * out.runs_total;
+  out.spec = std::move(job.spec);
+  out.runs_total = job.runs;
+  out.samples_total = job.samples_total;
   return out;
 }
 
@@ -702,6 +606,7 @@ void JobManager::RunClusterJob(const std::shared_ptr<LiveJob>& live) {
         }
         if (progress->done == progress->total) {
           const v1::JobResult result = run->Merge(version_);
+          app::CheckResultStatistics(result);  // never a non-finite statistic stored as success
           store_->StoreResult(id, SerializeDeterministic(result), UnixNow());
           final_state = v1::SUCCEEDED;
           break;
@@ -756,6 +661,7 @@ void JobManager::RunJob(const std::shared_ptr<LiveJob>& live) {
     } else {
       const v1::JobResult result =
           app::ToJobResult(app::JobAsRun(request.job(), job.spec), output, version_);
+      app::CheckResultStatistics(result);  // never a non-finite statistic stored as success
       store_->StoreResult(id, SerializeDeterministic(result), UnixNow());
       final_state = v1::SUCCEEDED;
     }

@@ -163,10 +163,10 @@ TEST(HostileInput, OutputNeverReplacesASymlinkOrAFifo) {
   EXPECT_EQ(RunDriftlab({"datasheet", sheet.string(), "--out", fifo.string()}, scratch).exit_status,
             2);
   EXPECT_TRUE(fs::is_fifo(fifo));
-  // A missing directory: the system's reason, never "Success".
+  // A missing directory: the system's reason, never "Success". A short path, so that the message
+  // (its echoed paths cut at kMaxMessageValueBytes) keeps the reason after them.
   const Result missing = RunDriftlab(
-      {"datasheet", sheet.string(), "--out", (scratch.dir() / "no" / "such.json").string()},
-      scratch);
+      {"datasheet", sheet.string(), "--out", "/nonexistent-driftlab-test-dir/such.json"}, scratch);
   EXPECT_NE(missing.exit_status, 0);
   EXPECT_EQ(missing.err.find("Success"), std::string::npos) << missing.err;
   EXPECT_NE(missing.err.find("No such file or directory"), std::string::npos) << missing.err;

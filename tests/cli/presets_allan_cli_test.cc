@@ -311,10 +311,11 @@ TEST(AllanCli, BadInputNamesTheFieldTheValueAndTheAllowedRange) {
               {"gyro_deg_per_s", "2 samples", "at least 3"});
   const std::string missing = (scratch.dir() / "missing.csv").string();
   ExpectError(scratch, {"allan", missing, "--rate", "10"}, 2, {"DATA", "missing.csv"});
-  // Writing the result is I/O: exit 1 naming --out and the path.
+  // An --out whose directory cannot take a file is refused before the work (CheckOutputWritable):
+  // exit 2 naming --out and the path.
   const std::string bad_out = (scratch.dir() / "no_dir" / "r.json").string();
   ExpectError(scratch,
-              {"allan", g, "--rate", "10", "--columns", "gyro_deg_per_s", "--out", bad_out}, 1,
+              {"allan", g, "--rate", "10", "--columns", "gyro_deg_per_s", "--out", bad_out}, 2,
               {"--out", "no_dir"});
 }
 

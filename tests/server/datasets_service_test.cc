@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "driftlab/app/job_file.h"
+#include "driftlab/app/job_validator.h"
 #include "driftlab/app/monte_carlo_job.h"
 #include "driftlab/app/sensor_model.h"
 #include "driftlab/app/translate.h"
@@ -163,7 +164,7 @@ TEST_F(DatasetsServiceTest, ExportedImuAndTruthRowsEqualTheDriftlabExportCsv) {
       std::filesystem::temp_directory_path() / ("datasets_test_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   {
-    const SimulationSpec spec = app::ValidateJob(app::JobFile{job, ""});
+    const SimulationSpec spec = app::ValidateJob(app::JobFile{job, ""}).spec.simulation;
     const SensorRun sensor{*app::ToImuErrorModel(job), kSeed, kRun};
     TruthCsvWriter truth(dir / "truth.csv");
     ImuCsvWriter imu(dir / "imu.csv");

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <limits>
 
+#include "driftlab/app/schema_check.h"
 #include "driftlab/server/auth.h"
 #include "driftlab/server/job_manager.h"
 #include "driftlab/server/job_store.h"
@@ -135,7 +136,7 @@ TEST(JobRequestCheckTest, UnknownEnumNonFiniteNumberAndUnknownFieldNameTheirPath
   v1::Job job = StaticJob(10.0, 2);
   job.mutable_navigation()->set_mechanization(static_cast<v1::Navigation::Mechanization>(7));
   try {
-    server::CheckMessageValues(job);
+    app::CheckMessageValues(job);
     ADD_FAILURE() << "unknown enum accepted";
   } catch (const SpecError& e) {
     EXPECT_EQ(e.field(), "navigation.mechanization");
@@ -145,7 +146,7 @@ TEST(JobRequestCheckTest, UnknownEnumNonFiniteNumberAndUnknownFieldNameTheirPath
   job.mutable_monte_carlo()->add_epoch_times_s(1.0);
   job.mutable_monte_carlo()->add_epoch_times_s(-std::numeric_limits<double>::infinity());
   try {
-    server::CheckMessageValues(job);
+    app::CheckMessageValues(job);
     ADD_FAILURE() << "infinite value accepted";
   } catch (const SpecError& e) {
     EXPECT_EQ(e.field(), "monte_carlo.epoch_times_s[1]");
@@ -157,13 +158,13 @@ TEST(JobRequestCheckTest, UnknownEnumNonFiniteNumberAndUnknownFieldNameTheirPath
       ->MutableUnknownFields(job.mutable_motion()->mutable_initial())
       ->AddVarint(999, 1);
   try {
-    server::CheckMessageValues(job);
+    app::CheckMessageValues(job);
     ADD_FAILURE() << "unknown field accepted";
   } catch (const SpecError& e) {
     EXPECT_EQ(e.field(), "motion.initial");
     EXPECT_NE(std::string(e.what()).find("999"), std::string::npos);
   }
-  EXPECT_NO_THROW(server::CheckMessageValues(StaticJob(10.0, 2)));
+  EXPECT_NO_THROW(app::CheckMessageValues(StaticJob(10.0, 2)));
 }
 
 TEST(JobRequestCheckTest, CostIsRunsTimesTheEnginesSamplesPerRun) {

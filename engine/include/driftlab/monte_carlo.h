@@ -31,14 +31,33 @@
 
 namespace driftlab {
 
-// 1-sigma initial navigation errors, independent Gaussian per axis and per run (zero = none).
-// Drawn from RandomStream(seed, run, {SensorId::kInitialConditions, axis, ErrorTerm::kInitialError,
-// component 0 = position, 1 = velocity, 2 = attitude, 3 = alignment heading}) at index 0.
+// Initial navigation errors of each run: 1-sigma random parts, independent Gaussian per axis and
+// per run (zero = none), plus fixed parts, the same in every run. The random parts are drawn from
+// RandomStream(seed, run, {SensorId::kInitialConditions, axis, ErrorTerm::kInitialError, component
+// 0 = position, 1 = velocity, 2 = attitude (Euler), 3 = alignment heading, 4 = attitude rotation})
+// at index 0.
 struct InitialErrorSigmas {
   Eigen::Vector3d position_ned_m = Eigen::Vector3d::Zero();        // N, E, D [m]
   Eigen::Vector3d velocity_ned_m_per_s = Eigen::Vector3d::Zero();  // N, E, D [m/s]
   // Added to the truth's roll, pitch and yaw (Euler angles of C_b_n) [rad].
   Eigen::Vector3d attitude_rad = Eigen::Vector3d::Zero();
+  // The attitude error as a rotation psi_nb_n about the N, E, D axes [rad]:
+  // C_b_n(start) = exp([psi x]) C_b_n (attitude.h AttitudeErrorNed), applied after attitude_rad.
+  Eigen::Vector3d attitude_ned_rad = Eigen::Vector3d::Zero();
+  // Fixed errors added to every run's draw: position N, E, D [m], velocity N, E, D [m/s], and the
+  // attitude rotation psi_nb_n [rad] (exp([psi x]) with psi = fixed + random).
+  Eigen::Vector3d fixed_position_ned_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d fixed_velocity_ned_m_per_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d fixed_attitude_ned_rad = Eigen::Vector3d::Zero();
+
+  bool attitude_is_zero() const {
+    return attitude_rad.isZero(0.0) && attitude_ned_rad.isZero(0.0) &&
+           fixed_attitude_ned_rad.isZero(0.0);
+  }
+  bool is_zero() const {
+    return attitude_is_zero() && position_ned_m.isZero(0.0) && velocity_ned_m_per_s.isZero(0.0) &&
+           fixed_position_ned_m.isZero(0.0) && fixed_velocity_ned_m_per_s.isZero(0.0);
+  }
 };
 
 // How mechanization A (MechanizationKind::kNed) is initialised. Mechanization B

@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace driftlab {
 
@@ -25,6 +26,29 @@ class OutputError : public std::runtime_error {
 // when `path` exists and is not a regular file. For checking command-line outputs before the work
 // starts. (A missing directory is an I/O error when the file is written: OutputError.)
 void CheckOutputPath(const std::filesystem::path& path, const std::string& field);
+
+// A file a command reads or writes and the option or argument that names it ("--out", "JOB").
+struct CommandPath {
+  std::filesystem::path path;
+  std::string option;
+};
+
+// Refuses an output that would replace one of the command's inputs or another of its outputs:
+// files are compared by device and inode, so another spelling ("./x", "d/../x"), a symbolic link
+// or a hard link to the same file matches. An output that exists is identified by its own inode;
+// one that does not exist yet by its directory's device and inode and its name (the file it would
+// be created as). Inputs that do not exist are skipped (their reader reports them). Throws
+// SpecError(output option, "'PATH' (the same file as INPUT_OPTION 'INPUT')", ...) for the first
+// clash, in the order of `outputs`.
+void CheckOutputsApart(const std::vector<CommandPath>& inputs,
+                       const std::vector<CommandPath>& outputs);
+
+// Checks, before the work, that a file can be created where `path` would be written, by creating
+// and removing a temporary file in its directory, or, with `creates_directories` and a directory
+// that does not exist yet, in its nearest existing ancestor (where the writer would create the
+// missing ones). Throws SpecError(field, "'PATH' (cannot create a file in 'DIR': reason)", ...).
+void CheckOutputWritable(const std::filesystem::path& path, const std::string& field,
+                         bool creates_directories = false);
 
 // One output file being written. Construction checks the target (CheckOutputPath) and creates
 // the temporary file beside it; Commit() makes it the target; destruction without Commit() removes

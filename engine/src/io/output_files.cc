@@ -7,6 +7,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <system_error>
 #include <vector>
 
 #include "driftlab/spec_error.h"
@@ -45,6 +46,111 @@ void CheckOutputPath(const std::filesystem::path& path, const std::string& field
     throw SpecError(field, "'" + path.string() + "' (" + std::strerror(errno) + ")",
                     "a writable path");
   }
+}
+
+namespace {
+
+// What a path names: an existing file's device and inode, or, for a file that does not exist yet,
+// its directory's device and inode and its name; a directory that does not exist either leaves
+// the lexically normalised absolute path.
+struct FileIdentity {
+  bool exists = false;
+  dev_t device = 0;
+  ino_t inode = 0;
+  std::string name;  // of a file that does not exist: its name in that directory (or full path)
+
+  bool operator==(const FileIdentity& other) const {
+    return exists == other.exists && device == other.device && inode == other.inode &&
+           name == other.name;
+  }
+};
+
+FileIdentity IdentityOf(const std::filesystem::path& path) {
+  FileIdentity id;
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0) {
+    id.exists = true;
+    id.device = st.st_dev;
+    id.inode = st.st_ino;
+    return id;
+  }
+  if (::stat(DirectoryOf(path).c_str(), &st) == 0) {
+    id.device = st.st_dev;
+    id.inode = st.st_ino;
+    id.name = path.filename().string();
+    return id;
+  }
+  std::error_code error;
+  id.name = std::filesystem::weakly_canonical(std::filesystem::absolute(path, error), error)
+                .lexically_normal()
+                .string();
+  return id;
+}
+
+std::string Quoted(const std::filesystem::path& path) {
+  return "'" + MessageText(path.string(), kMaxMessageValueBytes) + "'";
+}
+
+}  // namespace
+
+void CheckOutputsApart(const std::vector<CommandPath>& inputs,
+                       const std::vector<CommandPath>& outputs) {
+  std::vector<FileIdentity> input_ids;
+  for (const CommandPath& input : inputs) input_ids.push_back(IdentityOf(input.path));
+  std::vector<FileIdentity> output_ids;
+  for (const CommandPath& output : outputs) {
+    const FileIdentity id = IdentityOf(output.path);
+    const std::string allowed =
+        "a path that names none of the command's inputs and no other output (compared by device "
+        "and inode)";
+    for (size_t i = 0; i < inputs.size(); ++i) {
+      if (input_ids[i].exists && id == input_ids[i]) {
+        throw SpecError(output.option,
+                        Quoted(output.path) + " (the same file as " + inputs[i].option + " " +
+                            Quoted(inputs[i].path) + ", an input)",
+                        allowed);
+      }
+    }
+    for (size_t j = 0; j < output_ids.size(); ++j) {
+      if (id == output_ids[j]) {
+        throw SpecError(output.option,
+                        Quoted(output.path) + " (the same file as " + outputs[j].option + " " +
+                            Quoted(outputs[j].path) + ", another output)",
+                        allowed);
+      }
+    }
+    output_ids.push_back(id);
+  }
+}
+
+void CheckOutputWritable(const std::filesystem::path& path, const std::string& field,
+                         bool creates_directories) {
+  std::filesystem::path dir = std::filesystem::absolute(DirectoryOf(path)).lexically_normal();
+  struct stat st {};
+  while (creates_directories && ::stat(dir.c_str(), &st) != 0 && errno == ENOENT &&
+         dir.has_relative_path()) {
+    dir = dir.parent_path();
+  }
+  std::string reason;
+  if (::stat(dir.c_str(), &st) != 0) {
+    reason = std::strerror(errno);
+  } else if (!S_ISDIR(st.st_mode)) {
+    reason = "not a directory";
+  } else {
+    std::string pattern = (dir / ".driftlab-write-check-XXXXXX").string();
+    std::vector<char> name(pattern.begin(), pattern.end());
+    name.push_back('\0');
+    const int fd = ::mkstemp(name.data());
+    if (fd >= 0) {
+      ::close(fd);
+      ::unlink(name.data());
+      return;
+    }
+    reason = std::strerror(errno);
+  }
+  throw SpecError(field,
+                  Quoted(path) + " (cannot create a file in " + Quoted(dir) + ": " + reason + ")",
+                  "a path in a directory where files can be created");
 }
 
 OutputFile::OutputFile(const std::filesystem::path& path, const std::string& field)

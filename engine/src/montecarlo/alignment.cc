@@ -25,11 +25,13 @@ Eigen::Vector3d InitialErrorDraw(uint64_t seed, uint32_t run, uint8_t component,
 }
 
 NavState PerturbedStart(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run) {
+  const InitialErrorSigmas& errors = spec.initial_errors;
   NavState init = s.truth_start;
-  const Eigen::Vector3d dr =
-      InitialErrorDraw(spec.seed, run, 0, spec.initial_errors.position_ned_m);
-  const Eigen::Vector3d dv =
-      InitialErrorDraw(spec.seed, run, 1, spec.initial_errors.velocity_ned_m_per_s);
+  Eigen::Vector3d dr = InitialErrorDraw(spec.seed, run, 0, errors.position_ned_m);
+  Eigen::Vector3d dv = InitialErrorDraw(spec.seed, run, 1, errors.velocity_ned_m_per_s);
+  // The fixed parts only where given, so that a job without them keeps its bits (-0 + 0 = +0).
+  if (!errors.fixed_position_ned_m.isZero(0.0)) dr += errors.fixed_position_ned_m;
+  if (!errors.fixed_velocity_ned_m_per_s.isZero(0.0)) dv += errors.fixed_velocity_ned_m_per_s;
   // Curvilinear position offset with the environment's radii (as PositionErrorNed measures it).
   const double L = init.llh.lat_rad;
   const double h = init.llh.h_m;
@@ -65,15 +67,51 @@ NavState NedStartState(const SharedTruth& s, const MonteCarloSpec& spec, uint32_
     }
     init.q_b_n = Quaterniond(EulerToDcm(e));
   } else {
+    const InitialErrorSigmas& errors = spec.initial_errors;
     EulerAngles e = s.truth_start.euler();
-    const Eigen::Vector3d da =
-        InitialErrorDraw(spec.seed, run, 2, spec.initial_errors.attitude_rad);
+    const Eigen::Vector3d da = InitialErrorDraw(spec.seed, run, 2, errors.attitude_rad);
     e.roll_rad += da.x();
     e.pitch_rad += da.y();
     e.yaw_rad += da.z();
-    init.q_b_n = Quaterniond(EulerToDcm(e));
+    if (errors.attitude_ned_rad.isZero(0.0) && errors.fixed_attitude_ned_rad.isZero(0.0)) {
+      init.q_b_n = Quaterniond(EulerToDcm(e));
+    } else {
+      // The attitude error as a rotation about the navigation axes:
+      //   C_b_n(start) = exp([psi x]) C_b_n,  psi = fixed + N(0, sigma^2) per axis
+      // (psi_nb_n of attitude.h AttitudeErrorNed; Groves 2nd ed. (5.73) for the exponential).
+      const Eigen::Vector3d psi = errors.fixed_attitude_ned_rad +
+                                  InitialErrorDraw(spec.seed, run, 4, errors.attitude_ned_rad);
+      init.q_b_n = Quaterniond(RotationVectorToDcm(psi) * EulerToDcm(e)).normalized();
+    }
   }
   return init;
+}
+
+ErrorStateMatrix StartErrorCovariance(const MonteCarloSpec& spec, const EulerAngles& attitude,
+                                      const ErrorStateNoise& noise) {
+  const InitialErrorSigmas& errors = spec.initial_errors;
+  if (errors.attitude_ned_rad.isZero(0.0) && errors.fixed_position_ned_m.isZero(0.0) &&
+      errors.fixed_velocity_ned_m_per_s.isZero(0.0) && errors.fixed_attitude_ned_rad.isZero(0.0)) {
+    return InitialErrorCovariance(errors.position_ned_m, errors.velocity_ned_m_per_s,
+                                  errors.attitude_rad, attitude, noise);
+  }
+  // The EKF cannot know the fixed part: it is told the mean-square error per axis,
+  // sigma^2 + fixed^2. The covariance analysis of the free INS predicts the spread about the mean
+  // (the fixed part moves the mean only, the error model being linear): sigma^2.
+  const bool ekf = spec.filter == NavigationFilterKind::kInsGnssEkf;
+  const auto mean_square = [ekf](const Eigen::Vector3d& sigma, const Eigen::Vector3d& fixed) {
+    return Eigen::Vector3d(ekf ? (sigma.cwiseAbs2() + fixed.cwiseAbs2()).cwiseSqrt() : sigma);
+  };
+  ErrorStateMatrix P = InitialErrorCovariance(
+      mean_square(errors.position_ned_m, errors.fixed_position_ned_m),
+      mean_square(errors.velocity_ned_m_per_s, errors.fixed_velocity_ned_m_per_s),
+      errors.attitude_rad, attitude, noise);
+  // psi = exp-rotation about n applied after the Euler perturbation: independent, so the
+  // covariances of psi_nb_n add (to first order).
+  const Eigen::Vector3d psi_sigma =
+      mean_square(errors.attitude_ned_rad, errors.fixed_attitude_ned_rad);
+  P.block<3, 3>(kErrAttitude, kErrAttitude) += psi_sigma.cwiseAbs2().asDiagonal();
+  return P;
 }
 
 bool UseGyrocompass(const MonteCarloSpec& spec, const SharedTruth& truth) {

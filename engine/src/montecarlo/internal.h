@@ -198,6 +198,11 @@ NavState PerturbedStart(const SharedTruth& s, const MonteCarloSpec& spec, uint32
 NavState NedStartState(const SharedTruth& s, const MonteCarloSpec& spec, uint32_t run,
                        bool gyrocompass, const Eigen::Vector3d& sum_dtheta,
                        const Eigen::Vector3d& sum_dv);
+// The initial error covariance of the EKF and of the covariance analysis from the job's initial
+// errors (InitialErrorCovariance of error_state.h, plus the attitude rotation's sigma; the EKF is
+// given sigma^2 + fixed^2 per axis) at the truth's start attitude.
+ErrorStateMatrix StartErrorCovariance(const MonteCarloSpec& spec, const EulerAngles& attitude,
+                                      const ErrorStateNoise& noise);
 // Gyrocompass or external heading: one decision per job (it depends on the model only).
 bool UseGyrocompass(const MonteCarloSpec& spec, const SharedTruth& truth);
 

@@ -127,9 +127,7 @@ ErrorStateNoiseFromImu PrepareFilterModel(const MonteCarloSpec& spec, SharedTrut
   ErrorStateNoiseFromImu noise = FilterErrorModel(spec, *s);
   if (spec.filter == NavigationFilterKind::kInsGnssEkf || spec.covariance) {
     s->ekf_noise = noise.noise;
-    s->ekf_P0 = InitialErrorCovariance(
-        spec.initial_errors.position_ned_m, spec.initial_errors.velocity_ned_m_per_s,
-        spec.initial_errors.attitude_rad, s->truth_start.euler(), noise.noise);
+    s->ekf_P0 = StartErrorCovariance(spec, s->truth_start.euler(), noise.noise);
   }
   return noise;
 }

@@ -135,12 +135,18 @@ void ValidateFilter(const MonteCarloSpec& spec) {
   }
   if (f == NavigationFilterKind::kComplementary) {
     const InitialErrorSigmas& e = spec.initial_errors;
-    if (!e.position_ned_m.isZero(0.0) || !e.velocity_ned_m_per_s.isZero(0.0)) {
-      throw SpecError("monte_carlo.initial_errors", "non-zero position or velocity sigma",
+    if (!e.position_ned_m.isZero(0.0) || !e.velocity_ned_m_per_s.isZero(0.0) ||
+        !e.fixed_position_ned_m.isZero(0.0) || !e.fixed_velocity_ned_m_per_s.isZero(0.0)) {
+      throw SpecError("monte_carlo.initial_errors", "non-zero position or velocity errors",
                       "zero with navigation.filter COMPLEMENTARY (it estimates attitude only)");
     }
+    if (!e.attitude_ned_rad.isZero(0.0) || !e.fixed_attitude_ned_rad.isZero(0.0)) {
+      throw SpecError("monte_carlo.initial_errors.attitude_ned_deg", "non-zero",
+                      "absent with navigation.filter COMPLEMENTARY (its initial yaw error is "
+                      "monte_carlo.initial_errors.attitude_deg[2])");
+    }
     if (e.attitude_rad.x() != 0.0 || e.attitude_rad.y() != 0.0) {
-      throw SpecError("monte_carlo.initial_errors.attitude_rad", "non-zero roll or pitch sigma",
+      throw SpecError("monte_carlo.initial_errors.attitude_deg", "non-zero roll or pitch sigma",
                       "zero roll and pitch with navigation.filter COMPLEMENTARY (it levels from "
                       "the accelerometer; only the initial yaw error is used)");
     }
@@ -186,8 +192,24 @@ void ValidateSpec(const MonteCarloSpec& spec) {
                  "m");
   ValidateSigmas(spec.initial_errors.velocity_ned_m_per_s,
                  "monte_carlo.initial_errors.velocity_ned_m_per_s", "m/s");
-  ValidateSigmas(spec.initial_errors.attitude_rad, "monte_carlo.initial_errors.attitude_rad",
+  ValidateSigmas(spec.initial_errors.attitude_rad, "monte_carlo.initial_errors.attitude_deg",
                  "rad");
+  ValidateSigmas(spec.initial_errors.attitude_ned_rad,
+                 "monte_carlo.initial_errors.attitude_ned_deg", "rad");
+  const auto require_finite = [](const Eigen::Vector3d& v, const std::string& field) {
+    for (int i = 0; i < 3; ++i) {
+      if (!std::isfinite(v[i])) {
+        throw SpecError(IndexedField(field, static_cast<size_t>(i)), ValueText(v[i]),
+                        "a finite number");
+      }
+    }
+  };
+  require_finite(spec.initial_errors.fixed_position_ned_m,
+                 "monte_carlo.initial_errors.fixed_position_ned_m");
+  require_finite(spec.initial_errors.fixed_velocity_ned_m_per_s,
+                 "monte_carlo.initial_errors.fixed_velocity_ned_m_per_s");
+  require_finite(spec.initial_errors.fixed_attitude_ned_rad,
+                 "monte_carlo.initial_errors.fixed_attitude_ned_deg");
   if (spec.epoch_times_s.empty()) {
     if (spec.epoch_every_samples < 1) {
       throw SpecError("monte_carlo.epoch_every_samples", std::to_string(spec.epoch_every_samples),
@@ -205,33 +227,32 @@ void ValidateSpec(const MonteCarloSpec& spec) {
   const bool seed000 = spec.simulation.mechanization == MechanizationKind::kSeed000;
   if (seed000) {
     if (spec.initialization != InitializationKind::kTruthPlusErrors) {
-      throw SpecError("monte_carlo.initialization", "static_alignment",
-                      "truth_plus_errors with mechanization seed000 (it initialises itself from "
-                      "its static period)");
+      throw SpecError("monte_carlo.initialization.kind", "STATIC_ALIGNMENT",
+                      "TRUTH_PLUS_ERRORS with navigation.mechanization SEED000 (it initialises "
+                      "itself from its static period)");
     }
-    const InitialErrorSigmas& e = spec.initial_errors;
-    if (!e.position_ned_m.isZero(0.0) || !e.velocity_ned_m_per_s.isZero(0.0) ||
-        !e.attitude_rad.isZero(0.0)) {
+    if (!spec.initial_errors.is_zero()) {
       throw SpecError("monte_carlo.initial_errors", "non-zero",
-                      "zero with mechanization seed000 (it initialises itself from its static "
-                      "period)");
+                      "zero with navigation.mechanization SEED000 (it initialises itself from its "
+                      "static period)");
     }
   }
   if (!seed000 && spec.initialization == InitializationKind::kStaticAlignment) {
     const AlignmentOptions& a = spec.alignment;
     if (!std::isfinite(a.duration_s) || a.duration_s <= 0.0) {
-      throw SpecError("monte_carlo.alignment.duration_s", ValueText(a.duration_s),
+      throw SpecError("monte_carlo.initialization.alignment_duration_s", ValueText(a.duration_s),
                       "a finite duration > 0 [s]");
     }
     if (a.heading_sigma_rad &&
         (!std::isfinite(*a.heading_sigma_rad) || *a.heading_sigma_rad <= 0.0)) {
-      throw SpecError("monte_carlo.alignment.heading_sigma_rad", ValueText(*a.heading_sigma_rad),
-                      "a finite 1-sigma > 0 [rad], or absent (always gyrocompass)");
+      throw SpecError("monte_carlo.initialization.heading_sigma_deg",
+                      ValueText(*a.heading_sigma_rad * 180.0 / M_PI),
+                      "a finite 1-sigma > 0 [deg], or absent (always gyrocompass)");
     }
-    if (!spec.initial_errors.attitude_rad.isZero(0.0)) {
-      throw SpecError("monte_carlo.initial_errors.attitude_rad", "non-zero",
-                      "zero with initialization static_alignment (the attitude comes from the "
-                      "alignment)");
+    if (!spec.initial_errors.attitude_is_zero()) {
+      throw SpecError("monte_carlo.initial_errors", "non-zero attitude errors",
+                      "no attitude errors with initialization STATIC_ALIGNMENT (the attitude "
+                      "comes from the alignment)");
     }
   }
   ValidateFilter(spec);
@@ -256,7 +277,7 @@ JobPlan PlanJob(const MonteCarloSpec& spec, const TrajectoryGenerator& generator
     const double T = spec.alignment.duration_s;
     plan.start_step = std::llround(T / dt_s);
     if (plan.start_step < 1 || plan.start_step > plan.n) {
-      throw SpecError("monte_carlo.alignment.duration_s", ValueText(T),
+      throw SpecError("monte_carlo.initialization.alignment_duration_s", ValueText(T),
                       "[" + ValueText(dt_s) + ", " + ValueText(generator.duration_s()) +
                           "] s (at least one IMU sample, at most the trajectory)");
     }
@@ -269,13 +290,13 @@ JobPlan PlanJob(const MonteCarloSpec& spec, const TrajectoryGenerator& generator
       if (t <= static_cast<double>(plan.start_step) * dt_s) is_static &= generator.IsStaticAt(t);
     }
     if (!is_static) {
-      throw SpecError("monte_carlo.alignment.duration_s", ValueText(T),
+      throw SpecError("monte_carlo.initialization.alignment_duration_s", ValueText(T),
                       "a window over which the trajectory is static (the vehicle moves before " +
                           ValueText(static_cast<double>(plan.start_step) * dt_s) + " s)");
     }
     if (!spec.alignment.heading_sigma_rad && generator.environment().model() == EarthModel::kFlat) {
-      throw SpecError("monte_carlo.alignment.heading_sigma_rad", "",
-                      "a 1-sigma > 0 [rad] with the flat Earth model (no Earth rotation to "
+      throw SpecError("monte_carlo.initialization.heading_sigma_deg", "",
+                      "a 1-sigma > 0 [deg] with the flat Earth model (no Earth rotation to "
                       "gyrocompass on)");
     }
   }
@@ -289,11 +310,13 @@ JobPlan PlanJob(const MonteCarloSpec& spec, const TrajectoryGenerator& generator
     }
     if (epoch_k.back() != plan.n) epoch_k.push_back(plan.n);
     if (epoch_k.size() > kMaxMonteCarloEpochs) {
-      throw SpecError(
-          "monte_carlo.epoch_every_samples", std::to_string(spec.epoch_every_samples),
-          "at least " +
-              std::to_string((plan.n - plan.start_step) / (kMaxMonteCarloEpochs - 1) + 1) +
-              " (at most " + std::to_string(kMaxMonteCarloEpochs) + " epochs)");
+      // The job states the interval in seconds (monte_carlo.epoch_interval_s).
+      const int64_t min_samples = (plan.n - plan.start_step) / (kMaxMonteCarloEpochs - 1) + 1;
+      throw SpecError("monte_carlo.epoch_interval_s",
+                      ValueText(static_cast<double>(spec.epoch_every_samples) * dt_s) + " s",
+                      "at least " + ValueText(static_cast<double>(min_samples) * dt_s) +
+                          " s, a multiple of 1 / rate_hz (at most " +
+                          std::to_string(kMaxMonteCarloEpochs) + " epochs)");
     }
   } else {
     if (spec.epoch_times_s.size() > kMaxMonteCarloEpochs) {

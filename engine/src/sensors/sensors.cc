@@ -121,9 +121,9 @@ void ValidateTriadErrorParams(const TriadErrorParams& p, const std::string& path
     RequireOpenUnit(p.scale_factor_asymmetry[i], Index(path + ".scale_factor_asymmetry", i));
   }
   RequireNonNegative(p.scale_factor_sigma, path + ".scale_factor_sigma");
-  if (p.scale_factor_sigma >= 0.1) {
+  if (p.scale_factor_sigma > 0.1 * (1.0 + 1e-12)) {  // 1e5 ppm, whatever its rounding
     throw SpecError(path + ".scale_factor_sigma", FormatValue(p.scale_factor_sigma),
-                    "0 <= value < 0.1 (10 %; dimensionless)");
+                    "0 <= value <= 0.1 (10 %; dimensionless)");
   }
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) {
@@ -140,9 +140,9 @@ void ValidateTriadErrorParams(const TriadErrorParams& p, const std::string& path
     }
   }
   RequireNonNegative(p.misalignment_sigma_rad, path + ".misalignment_sigma_rad");
-  if (p.misalignment_sigma_rad >= 0.1) {
+  if (p.misalignment_sigma_rad > 0.1 * (1.0 + 1e-12)) {  // 100 mrad, whatever its rounding
     throw SpecError(path + ".misalignment_sigma_rad", FormatValue(p.misalignment_sigma_rad),
-                    "0 <= value < 0.1 rad");
+                    "0 <= value <= 0.1 rad");
   }
   RequireNonNegative(p.quantization, path + ".quantization");
   RequireNonNegative(p.range, path + ".range");

@@ -103,9 +103,10 @@ TEST(AidedJob, DefaultsOfEachAid) {
   EXPECT_EQ(spec.aiding.barometer->bias.sigma, 0.0);
   EXPECT_EQ(spec.aiding.zupt->rate_hz, 1.0);
   EXPECT_EQ(spec.ekf_propagation_step_samples, 10);
-  // An aid whose message is absent, or ZUPT not enabled, is not used.
-  const MonteCarloSpec off = ToMonteCarloSpec(
-      File(AidedJob(kEkf, R"({"gnss": {}, "zupt": {"velocity_sigma_m_per_s": 0.1}})")), {});
+  // An aid whose message is absent, or ZUPT not enabled, is not used (ZUPT settings with
+  // enabled false are refused: JobValidator's ZuptOptionWhileDisabled).
+  const MonteCarloSpec off =
+      ToMonteCarloSpec(File(AidedJob(kEkf, R"({"gnss": {}, "zupt": {"enabled": false}})")), {});
   EXPECT_FALSE(off.aiding.zupt.has_value());
   EXPECT_FALSE(off.aiding.barometer.has_value());
 

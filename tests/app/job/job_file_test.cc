@@ -11,6 +11,7 @@
 #include <string>
 #include <variant>
 
+#include "driftlab/app/job_validator.h"
 #include "driftlab/app/translate.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/trajectory.h"
@@ -374,7 +375,7 @@ TEST(JobSpec, ImportedMotionFileResolvesAgainstTheJobFileDirectory) {
 
 TEST(JobSpec, TruthProfileFileIsTheWholeMotion) {
   const JobFile file = LoadJobFile(kExamples / "truth_profile_import.json");
-  const SimulationSpec spec = ValidateJob(file);
+  const SimulationSpec spec = ValidateJob(file).spec.simulation;
   // motions/north_drive_profile.csv: 31 samples from t = 0, at rest at 45 N, 7 E, 200 m.
   EXPECT_TRUE(spec.motion.segments.empty());
   ASSERT_EQ(spec.motion.truth_profile.size(), 31u);

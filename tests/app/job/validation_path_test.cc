@@ -61,7 +61,7 @@ TEST(ValidationPath, EpochLimitIsCheckedWithoutRunning) {
   ASSERT_LT(kMaxMonteCarloEpochs, size_t{1'000'001});
   EXPECT_EQ(
       RefusedField(JobWithMonteCarloAt(R"({"runs": 1, "epoch_interval_s": 0.01})", 100.0, 10000.0)),
-      "monte_carlo.epoch_every_samples");
+      "monte_carlo.epoch_interval_s");
   EXPECT_EQ(
       RefusedField(JobWithMonteCarloAt(R"({"runs": 1, "epoch_interval_s": 1})", 100.0, 10000.0)),
       "");

@@ -148,7 +148,7 @@ TEST(MonteCarloTest, BadSpecsNameTheField) {
   spec.initial_errors.attitude_rad = Vector3d::Zero();
   spec.initialization = InitializationKind::kStaticAlignment;
   spec.alignment.duration_s = 25.0;  // the vehicle starts moving at 20 s
-  ExpectSpecError(spec, "monte_carlo.alignment.duration_s");
+  ExpectSpecError(spec, "monte_carlo.initialization.alignment_duration_s");
 
   spec = SmallJob();
   spec.initial_errors.position_ned_m.y() = -1.0;

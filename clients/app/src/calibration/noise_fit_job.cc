@@ -148,6 +148,17 @@ v1::NoiseModelFit RunNoiseFit(const NoiseFitSettings& settings, const NumericTab
       if (c.gyro != gyro) continue;
       AllanOptions allan;
       allan.points_per_octave = settings.points_per_octave;
+      // A fit needs the deviation at two averaging times at least: the overlapping estimator has
+      // tau = m / rate_hz for m <= (N - 1) / 2 (allan.h), so m = 1, 2 from N = 5 samples.
+      constexpr size_t kMinFitSamples = 5;
+      if (c.samples.size() < kMinFitSamples) {
+        throw SpecError(fmt::format("{}: column '{}'", settings.data_name, c.name),
+                        fmt::format("{} samples", c.samples.size()),
+                        fmt::format("at least {} samples for a fit (the Allan deviation at two "
+                                    "averaging times; a useful fit needs a recording many times "
+                                    "longer than the longest time scale of interest)",
+                                    kMinFitSamples));
+      }
       curves.push_back(OverlappingAllanDeviation(c.samples, settings.rate_hz, allan));
       used.push_back(&c);
       const calib::NoiseFitResult fit = calib::FitAllanNoiseModel(curves.back(), fit_options);

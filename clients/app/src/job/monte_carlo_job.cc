@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "driftlab/aiding.h"
+#include "driftlab/app/result_file.h"
 #include "driftlab/app/sensor_model.h"
 #include "driftlab/app/translate.h"
 #include "driftlab/ins_gnss_filter.h"
@@ -21,6 +22,7 @@
 #include "driftlab/trajectory.h"
 #include "driftlab/units.h"
 #include "job/field_checks.h"
+#include "job/job_translation.h"
 
 namespace driftlab::app {
 namespace {
@@ -327,9 +329,9 @@ void ParseShard(const std::string& text, MonteCarloOverrides* overrides) {
   overrides->shard_count = k;
 }
 
-MonteCarloSpec ToMonteCarloSpec(const JobFile& file, const MonteCarloOverrides& overrides) {
+MonteCarloSpec TranslateMonteCarloJob(const JobFile& file, const MonteCarloOverrides& overrides) {
   MonteCarloSpec spec;
-  spec.simulation = ValidateJob(file);
+  spec.simulation = PlanSimulationSpec(file);
   spec.sensor = ToImuErrorModel(file.job);
   const v1::MonteCarlo& mc = file.job.monte_carlo();
   const double rate_hz = spec.simulation.rate_hz;
@@ -363,15 +365,43 @@ MonteCarloSpec ToMonteCarloSpec(const JobFile& file, const MonteCarloOverrides& 
   }
 
   const v1::InitialErrors& initial = mc.initial_errors();
-  spec.initial_errors.position_ned_m =
-      Sigmas(initial.position_ned_m(), "monte_carlo.initial_errors.position_ned_m",
-             kMaxInitialPosition_m, "m", 1.0);
-  spec.initial_errors.velocity_ned_m_per_s =
-      Sigmas(initial.velocity_ned_m_per_s(), "monte_carlo.initial_errors.velocity_ned_m_per_s",
-             kMaxInitialVelocity_m_per_s, "m/s", 1.0);
-  spec.initial_errors.attitude_rad =
-      Sigmas(initial.attitude_deg(), "monte_carlo.initial_errors.attitude_deg",
-             kMaxInitialAttitude_deg, "deg", kDegToRad);
+  const std::string ie = "monte_carlo.initial_errors";
+  InitialErrorSigmas& errors = spec.initial_errors;
+  errors.position_ned_m =
+      Sigmas(initial.position_ned_m(), ie + ".position_ned_m", kMaxInitialPosition_m, "m", 1.0);
+  errors.velocity_ned_m_per_s = Sigmas(initial.velocity_ned_m_per_s(), ie + ".velocity_ned_m_per_s",
+                                       kMaxInitialVelocity_m_per_s, "m/s", 1.0);
+  errors.attitude_rad = Sigmas(initial.attitude_deg(), ie + ".attitude_deg",
+                               kMaxInitialAttitude_deg, "deg", kDegToRad);
+  if (!initial.attitude_deg().empty() && !initial.attitude_ned_deg().empty()) {
+    throw SpecError(ie + ".attitude_ned_deg", "given with attitude_deg",
+                    "one of attitude_ned_deg (a rotation about north, east, down) or attitude_deg "
+                    "(added to the Euler angles)");
+  }
+  errors.attitude_ned_rad = Sigmas(initial.attitude_ned_deg(), ie + ".attitude_ned_deg",
+                                   kMaxInitialAttitude_deg, "deg", kDegToRad);
+  errors.fixed_position_ned_m = Vector3Or(
+      initial.fixed_position_ned_m(), ie + ".fixed_position_ned_m",
+      Closed(-kMaxInitialPosition_m, kMaxInitialPosition_m, "m"), Eigen::Vector3d::Zero());
+  errors.fixed_velocity_ned_m_per_s =
+      Vector3Or(initial.fixed_velocity_ned_m_per_s(), ie + ".fixed_velocity_ned_m_per_s",
+                Closed(-kMaxInitialVelocity_m_per_s, kMaxInitialVelocity_m_per_s, "m/s"),
+                Eigen::Vector3d::Zero());
+  errors.fixed_attitude_ned_rad =
+      Vector3Or(initial.fixed_attitude_ned_deg(), ie + ".fixed_attitude_ned_deg",
+                Closed(-kMaxInitialAttitude_deg, kMaxInitialAttitude_deg, "deg"),
+                Eigen::Vector3d::Zero()) *
+      kDegToRad;
+  if (errors.fixed_attitude_ned_rad.norm() > kMaxInitialAttitude_deg * kDegToRad) {
+    throw SpecError(
+        ie + ".fixed_attitude_ned_deg",
+        fmt::format("a rotation of {} deg", errors.fixed_attitude_ned_rad.norm() * kRadToDeg),
+        fmt::format("a rotation of at most {} deg", kMaxInitialAttitude_deg));
+  }
+  // The first attitude field with a non-zero value, for the messages below.
+  const char* attitude_field = !errors.attitude_rad.isZero(0.0)       ? "attitude_deg"
+                               : !errors.attitude_ned_rad.isZero(0.0) ? "attitude_ned_deg"
+                                                                      : "fixed_attitude_ned_deg";
 
   const v1::Initialization& init = mc.initialization();
   const bool seed000 = spec.simulation.mechanization == MechanizationKind::kSeed000;
@@ -390,8 +420,8 @@ MonteCarloSpec ToMonteCarloSpec(const JobFile& file, const MonteCarloOverrides& 
                                                init.heading_sigma_deg(), Positive(180.0, "deg")) *
                                          kDegToRad;
     }
-    if (!spec.initial_errors.attitude_rad.isZero()) {
-      throw SpecError("monte_carlo.initial_errors.attitude_deg", "non-zero",
+    if (!errors.attitude_is_zero()) {
+      throw SpecError(ie + "." + attitude_field, "non-zero",
                       "empty or zeros with STATIC_ALIGNMENT (the attitude comes from the "
                       "alignment)");
     }
@@ -401,10 +431,8 @@ MonteCarloSpec ToMonteCarloSpec(const JobFile& file, const MonteCarloOverrides& 
       throw SpecError("monte_carlo.initialization.alignment_duration_s", "set",
                       "only with kind STATIC_ALIGNMENT");
     }
-    if (seed000 && !(spec.initial_errors.position_ned_m.isZero() &&
-                     spec.initial_errors.velocity_ned_m_per_s.isZero() &&
-                     spec.initial_errors.attitude_rad.isZero())) {
-      throw SpecError("monte_carlo.initial_errors", "non-zero",
+    if (seed000 && !errors.is_zero()) {
+      throw SpecError(ie, "non-zero",
                       "no initial errors with navigation.mechanization SEED000 (it initialises "
                       "itself from its static period)");
     }

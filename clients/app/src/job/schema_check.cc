@@ -1,6 +1,7 @@
 #include "driftlab/app/schema_check.h"
 
 #include <fmt/format.h>
+#include <google/protobuf/unknown_field_set.h>
 
 #include <algorithm>
 #include <charconv>
@@ -280,6 +281,103 @@ void CheckFieldSizes(const google::protobuf::Message& message, const std::string
       }
     }
   }
+}
+
+namespace {
+
+std::string FieldPath(const std::string& path, const FieldDescriptor& field, int index) {
+  std::string out = path.empty() ? field.name() : path + "." + field.name();
+  if (index >= 0) out += "[" + std::to_string(index) + "]";
+  return out;
+}
+
+void CheckFieldValue(const google::protobuf::Message& message, const FieldDescriptor& field,
+                     int index, const std::string& path) {
+  const google::protobuf::Reflection& r = *message.GetReflection();
+  const bool repeated = field.is_repeated();
+  switch (field.cpp_type()) {
+    case FieldDescriptor::CPPTYPE_ENUM: {
+      const int value = repeated ? r.GetRepeatedEnumValue(message, &field, index)
+                                 : r.GetEnumValue(message, &field);
+      if (field.enum_type()->FindValueByNumber(value) == nullptr) {
+        throw SpecError(FieldPath(path, field, index), std::to_string(value),
+                        EnumNames(*field.enum_type()));
+      }
+      break;
+    }
+    case FieldDescriptor::CPPTYPE_DOUBLE:
+    case FieldDescriptor::CPPTYPE_FLOAT: {
+      const double value = field.cpp_type() == FieldDescriptor::CPPTYPE_DOUBLE
+                               ? (repeated ? r.GetRepeatedDouble(message, &field, index)
+                                           : r.GetDouble(message, &field))
+                               : (repeated ? r.GetRepeatedFloat(message, &field, index)
+                                           : r.GetFloat(message, &field));
+      if (!std::isfinite(value)) {
+        throw SpecError(FieldPath(path, field, index),
+                        std::isnan(value) ? "NaN" : (value > 0 ? "Infinity" : "-Infinity"),
+                        "a finite number");
+      }
+      break;
+    }
+    case FieldDescriptor::CPPTYPE_MESSAGE:
+      CheckMessageValues(
+          repeated ? r.GetRepeatedMessage(message, &field, index) : r.GetMessage(message, &field),
+          FieldPath(path, field, index));
+      break;
+    default:
+      break;
+  }
+}
+
+}  // namespace
+
+void CheckMessageValues(const google::protobuf::Message& message, const std::string& path) {
+  const google::protobuf::Reflection& r = *message.GetReflection();
+  const google::protobuf::UnknownFieldSet& unknown = r.GetUnknownFields(message);
+  if (!unknown.empty()) {
+    throw SpecError(path.empty() ? "(job)" : path,
+                    "unknown field number " + std::to_string(unknown.field(0).number()),
+                    "the fields of " + message.GetDescriptor()->full_name());
+  }
+  std::vector<const FieldDescriptor*> fields;
+  r.ListFields(message, &fields);  // set fields, in field-number order
+  for (const FieldDescriptor* field : fields) {
+    if (field->is_map()) continue;
+    if (field->is_repeated()) {
+      for (int i = 0; i < r.FieldSize(message, field); ++i) {
+        CheckFieldValue(message, *field, i, path);
+      }
+    } else {
+      CheckFieldValue(message, *field, -1, path);
+    }
+  }
+}
+
+bool IsSchemaFieldPath(const Descriptor& descriptor, std::string_view path) {
+  const Descriptor* message = &descriptor;
+  while (!path.empty()) {
+    if (message == nullptr) return false;  // a scalar field has no sub-fields
+    const size_t dot = path.find('.');
+    std::string_view part = path.substr(0, dot);
+    path = dot == std::string_view::npos ? std::string_view() : path.substr(dot + 1);
+    if (dot != std::string_view::npos && path.empty()) return false;  // a trailing dot
+    const size_t bracket = part.find('[');
+    const std::string_view name = part.substr(0, bracket);
+    const FieldDescriptor* field = message->FindFieldByName(std::string(name));
+    if (field == nullptr) return false;
+    if (bracket != std::string_view::npos) {
+      // [digits] once, only on a repeated field, and nothing after it.
+      const std::string_view index = part.substr(bracket);
+      if (!field->is_repeated() || index.size() < 3 || index.back() != ']' ||
+          index.substr(1, index.size() - 2).find_first_not_of("0123456789") !=
+              std::string_view::npos) {
+        return false;
+      }
+    }
+    message =
+        field->cpp_type() == FieldDescriptor::CPPTYPE_MESSAGE ? field->message_type() : nullptr;
+  }
+  return true;
 }
 
 }  // namespace driftlab::app

@@ -125,6 +125,13 @@ void ApplyTriad(const Message& in, SensorTriad t, const std::string& prefix, Imu
         path, fmt::format("{}", out->bias_flicker.tau_min_s),
         fmt::format("0 < {} < {} = {} s", name(4), name(5), out->bias_flicker.tau_max_s));
   }
+  if (out->bias_flicker.bias_instability > 0.0 &&
+      out->bias_flicker.tau_max_s > kMaxFlickerRangeRatio * out->bias_flicker.tau_min_s) {
+    const std::string path = fmt::format("{}.{}", prefix, name(5));
+    throw SpecError(path, fmt::format("{}", out->bias_flicker.tau_max_s),
+                    fmt::format("{} <= 1e9 {} = {} s", name(5), name(4),
+                                kMaxFlickerRangeRatio * out->bias_flicker.tau_min_s));
+  }
 }
 
 bool IsEmpty(const v1::SensorModel& sensor) { return sensor.ByteSizeLong() == 0; }

@@ -12,6 +12,7 @@
 #include "driftlab/trajectory.h"
 #include "driftlab/units.h"
 #include "job/field_checks.h"
+#include "job/job_translation.h"
 
 namespace driftlab::app {
 namespace {
@@ -369,8 +370,21 @@ SimulationSpec ToSimulationSpec(const v1::Job& job, const std::filesystem::path&
   return spec;
 }
 
-SimulationSpec ValidateJob(const JobFile& file) {
-  CheckFieldSizes(file.job);
+std::vector<CommandPath> JobInputFiles(const v1::Job& job, const std::filesystem::path& base_dir) {
+  std::vector<CommandPath> out;
+  const v1::Motion& motion = job.motion();
+  if (motion.has_gnss_ins_sim_file() && !motion.gnss_ins_sim_file().path().empty()) {
+    out.push_back(
+        {Resolve(motion.gnss_ins_sim_file().path(), base_dir), "motion.gnss_ins_sim_file.path"});
+  }
+  if (motion.has_truth_profile_file() && !motion.truth_profile_file().path().empty()) {
+    out.push_back(
+        {Resolve(motion.truth_profile_file().path(), base_dir), "motion.truth_profile_file.path"});
+  }
+  return out;
+}
+
+SimulationSpec PlanSimulationSpec(const JobFile& file) {
   SimulationSpec spec = ToSimulationSpec(file.job, file.base_dir);
   TrajectoryGenerator planned(spec.motion, spec.rate_hz);
   if (spec.mechanization == MechanizationKind::kSeed000) {

@@ -233,6 +233,7 @@ v1::JobResult ToJobResult(const v1::Job& job_as_run, const MonteCarloStatistics&
                                        data.timings.wall_s
                                  : 0.0);
   timings->set_threads(static_cast<uint32_t>(data.timings.threads));
+  CheckResultStatistics(result);
   return result;
 }
 
@@ -242,7 +243,88 @@ v1::JobResult ToJobResult(const v1::Job& job_as_run, const MonteCarloOutput& out
   const std::vector<double>& times = output.statistics.data().epoch_times_s;
   if (output.covariance) SetCovariance(*output.covariance, times, &result);
   if (output.consistency) SetConsistency(*output.consistency, times, &result);
+  CheckResultStatistics(result);
   return result;
+}
+
+void CheckResultStatistics(const v1::JobResult& result) {
+  const auto refuse = [](const std::string& path, double value, const std::string& allowed) {
+    throw SpecError("result",
+                    fmt::format("{}: {} is not allowed; allowed: {} (a result with a non-finite "
+                                "statistic is neither written nor stored)",
+                                path, value, allowed),
+                    0);
+  };
+  const auto finite = [&refuse](const std::string& path, double value) {
+    if (!std::isfinite(value)) refuse(path, value, "a finite number");
+  };
+  // Whatever parts the result holds: a shard's runs, or the epochs alone (result_check.cc
+  // re-summarises a file's exact sums without its checkpoints). The sample sigma and its interval
+  // are NaN by definition for one run (result.proto); never infinite.
+  const bool single_run = result.run_count() == 1;
+  for (int e = 0; e < result.epochs_size(); ++e) {
+    for (int c = 0; c < result.epochs(e).components_size(); ++c) {
+      const v1::ComponentStatistics& s = result.epochs(e).components(c);
+      const std::string p = fmt::format("epochs[{}].components[{}].", e, c);
+      finite(p + "mean", s.mean());
+      finite(p + "rms", s.rms());
+      finite(p + "rms_ci95_low", s.rms_ci95_low());
+      finite(p + "rms_ci95_high", s.rms_ci95_high());
+      for (const auto& [name, value] : {std::pair<const char*, double>{"std", s.std()},
+                                        {"std_ci95_low", s.std_ci95_low()},
+                                        {"std_ci95_high", s.std_ci95_high()}}) {
+        if (single_run && std::isnan(value)) continue;
+        finite(p + name, value);
+      }
+    }
+  }
+  for (int k = 0; k < result.checkpoints_size(); ++k) {
+    const v1::Checkpoint& checkpoint = result.checkpoints(k);
+    const std::string p = fmt::format("checkpoints[{}].", k);
+    for (int c = 0; c < checkpoint.components_size(); ++c) {
+      const v1::ComponentPercentiles& q = checkpoint.components(c);
+      const std::string pc = fmt::format("{}components[{}].", p, c);
+      finite(pc + "p50", q.p50());
+      finite(pc + "p68", q.p68());
+      finite(pc + "p95", q.p95());
+      finite(pc + "p99", q.p99());
+      finite(pc + "max_abs", q.max_abs());
+    }
+    finite(p + "cep50_m", checkpoint.cep50_m());
+    finite(p + "cep95_m", checkpoint.cep95_m());
+    finite(p + "drms2_m", checkpoint.drms2_m());
+    for (int r = 0; r < checkpoint.runs_size(); ++r) {
+      for (int c = 0; c < checkpoint.runs(r).values_size(); ++c) {
+        finite(fmt::format("{}runs[{}].values[{}]", p, r, c), checkpoint.runs(r).values(c));
+      }
+    }
+  }
+  for (int e = 0; e < result.covariance().epochs_size(); ++e) {
+    const v1::PredictedEpoch& epoch = result.covariance().epochs(e);
+    for (int c = 0; c < epoch.sigma_size(); ++c) {
+      if (!(std::isfinite(epoch.sigma(c)) && epoch.sigma(c) >= 0.0)) {
+        refuse(fmt::format("covariance.epochs[{}].sigma[{}]", e, c), epoch.sigma(c),
+               "a finite sigma >= 0");
+      }
+    }
+  }
+  const v1::FilterConsistency& nees = result.filter_consistency();
+  for (int e = 0; e < nees.epochs_size(); ++e) {
+    const v1::NeesEpoch& epoch = nees.epochs(e);
+    const std::string path = fmt::format("filter_consistency.epochs[{}]", e);
+    if (epoch.has_average_nees() && !std::isfinite(epoch.average_nees())) {
+      refuse(path + ".average_nees", epoch.average_nees(), "a finite number");
+    }
+    if (epoch.has_chi2_95_low() && !std::isfinite(epoch.chi2_95_low())) {
+      refuse(path + ".chi2_95_low", epoch.chi2_95_low(), "a finite number");
+    }
+    if (epoch.has_chi2_95_high() && !std::isfinite(epoch.chi2_95_high())) {
+      refuse(path + ".chi2_95_high", epoch.chi2_95_high(), "a finite number");
+    }
+  }
+  if (nees.has_mean_average_nees() && !std::isfinite(nees.mean_average_nees())) {
+    refuse("filter_consistency.mean_average_nees", nees.mean_average_nees(), "a finite number");
+  }
 }
 
 MonteCarloStatistics StatisticsFromJobResult(const v1::JobResult& result,
@@ -351,6 +433,7 @@ v1::JobResult MergeJobResults(const std::vector<v1::JobResult>& shards,
     cpu_s += shard.timings().cpu_s();
   }
   if (all_cpu) result.mutable_timings()->set_cpu_s(cpu_s);
+  CheckResultStatistics(result);
   return result;
 }
 

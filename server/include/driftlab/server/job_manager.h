@@ -2,11 +2,13 @@
 // run Monte-Carlo jobs, cancellation, deadlines, progress for Watch, and graceful shutdown.
 //
 // A job runs exactly as `driftlab run` runs it (clients/cli/run_command.cc): the request's job
-// becomes a app::JobFile with no base directory, app::ToMonteCarloSpec validates and
-// translates it with the request's overrides, RunMonteCarlo runs it, and app::ToJobResult
-// turns the statistics into the stored driftlab.v1.JobResult. The engine's statistics are exact
-// sums whatever the thread count (monte_carlo.h), so the server's result equals the in-process one
-// bit for bit apart from the timings, and a job re-run after a crash gives the same result.
+// is validated and translated by app::ValidateJob (job_validator.h, the validator of every entry)
+// with the request's overrides and no file references, RunMonteCarloWithAnalysis runs it, and
+// app::ToJobResult turns the statistics into the stored driftlab.v1.JobResult (a result with a
+// non-finite statistic is refused there: the job fails instead of being stored as a success). The
+// engine's statistics are exact sums whatever the thread count (monte_carlo.h), so the server's
+// result equals the in-process one bit for bit apart from the timings, and a job re-run after a
+// crash gives the same result.
 //
 // CPU per job is bounded by running it with MonteCarloSpec::threads = threads_per_job: the engine
 // runs the job inside a tbb::task_arena of that many threads. Cancellation sets the job's
@@ -54,18 +56,13 @@ struct ValidatedJob {
   uint64_t samples_total = 0;  // runs_total x IMU samples per run
 };
 
-// Validates a SubmitJobRequest exactly as `driftlab validate` / `run` validate a job file, plus
-// what only the server checks: every enum value known, every floating-point field finite, no
-// unknown fields, no file references (motion.gnss_ins_sim_file, motion.truth_profile_file: the
-// server does not read files), runs in [1, 1000000], shard "i/K", deadline_s >= 0. Field paths
-// are those of the job file (e.g. "motion.segments[0].static.duration_s") and, for the request's
-// own fields, "runs", "seed", "shard", "deadline_s". Throws SpecError.
+// Validates a SubmitJobRequest with app::ValidateJob, exactly as `driftlab validate` / `run`
+// validate a job file (file references refused: the server does not read files), plus the
+// request's own fields: runs in [1, 1000000], shard "i/K", deadline_s >= 0. Field paths are those
+// of the job file (e.g. "motion.segments[0].static.duration_s") and, for the request's own fields,
+// "runs", "seed", "shard", "deadline_s". Throws SpecError.
 ValidatedJob ValidateSubmitRequest(const v1::SubmitJobRequest& request, int threads_per_job,
                                    uint64_t max_memory_bytes = kDefaultMaxJobMemoryBytes);
-
-// Throws SpecError for the first enum field holding a value its enum does not define, the first
-// non-finite double or float field, or the first unknown field, with its field path under `path`.
-void CheckMessageValues(const google::protobuf::Message& message, const std::string& path = "");
 
 // Serializes a message deterministically (map entries sorted): equal messages give equal bytes.
 std::string SerializeDeterministic(const google::protobuf::Message& message);

@@ -19,7 +19,9 @@
 namespace driftlab::app {
 
 // The result of a (shard of a) job. `cpu_s` is the process CPU time when measured (< 0: absent).
-// Throws SpecError for a cancelled job or runs that are not one contiguous range.
+// Throws SpecError for a cancelled job or runs that are not one contiguous range, and for a
+// statistic that is not finite (CheckResultStatistics): such a result is never written or stored
+// as a success.
 v1::JobResult ToJobResult(const v1::Job& job_as_run, const MonteCarloStatistics& statistics,
                           const std::string& engine_version, double cpu_s = -1.0);
 // The same with the analyses of RunMonteCarloWithAnalysis: `covariance` (predicted sigma per
@@ -27,6 +29,14 @@ v1::JobResult ToJobResult(const v1::Job& job_as_run, const MonteCarloStatistics&
 // epoch with its chi-square 95 % bounds; its exact sums go to merge_state for `merge`).
 v1::JobResult ToJobResult(const v1::Job& job_as_run, const MonteCarloOutput& output,
                           const std::string& engine_version, double cpu_s = -1.0);
+
+// The last check before a result is written (`run`, `merge`) or stored (the server): every
+// statistic the result holds finite (epochs, checkpoint summaries and per-run values, whichever
+// are present: a shard's partial statistics pass; the sample sigma and its interval may be NaN
+// for one run, result.proto), every predicted sigma of the covariance analysis finite and >= 0,
+// every average NEES and its bounds finite. The result's structure is ValidateJobResult's
+// (result_file.h). Throws SpecError("result", "<path>: nan is not allowed; ...").
+void CheckResultStatistics(const v1::JobResult& result);
 
 // Fills each checkpoint's percentiles, CEP50/95, 2DRMS and maxima from its per-run values.
 void FillCheckpointSummaries(v1::JobResult* result);

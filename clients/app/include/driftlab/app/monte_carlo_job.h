@@ -37,18 +37,9 @@ struct MonteCarloOverrides {
 // Parses "i/K" (`--shard`); throws SpecError("--shard", text, "i/K with 0 <= i < K, K >= 1").
 void ParseShard(const std::string& text, MonteCarloOverrides* overrides);
 
-// Translates and validates the whole job for a Monte-Carlo run: motion, rate and navigation
-// (ValidateJob), sensor (ToImuErrorModel), monte_carlo (runs, seed, initial errors,
-// initialization, epochs, checkpoints) and the overrides. Throws SpecError naming the field
-// ("monte_carlo.epoch_interval_s", "--runs", "--shard", ...). The engine checks the rest when it
-// runs (epochs outside the trajectory, alignment over a moving segment) with the same field paths.
-// Also navigation.filter / ekf / complementary and aiding (GNSS, barometer, magnetometer, ZUPT):
-// every number range-checked ("aiding.gnss.position_sigma_ned_m[2]"), outages ascending, not
-// overlapping and inside the trajectory ("aiding.gnss.outages[1].start_s" / ".end_s"), aiding
-// rates at most the IMU rate and dividing it, each aid only with the filter that uses it.
-// Ends with ValidateMonteCarloSpec (monte_carlo.h): every check RunMonteCarlo makes, including
-// those against the trajectory and the memory estimate, so that `validate`, `run` and the
-// server's Submit accept exactly the jobs that run.
+// The job's MonteCarloSpec as validated by ValidateJob (job_validator.h), the one validator every
+// entry calls: ValidateJob(file, {overrides}).spec. Throws SpecError naming the field
+// ("monte_carlo.epoch_interval_s", "aiding.gnss.outages[1].start_s", "--runs", "--shard", ...).
 MonteCarloSpec ToMonteCarloSpec(const JobFile& file, const MonteCarloOverrides& overrides);
 
 // The job as run: the job file's message with the overrides written into monte_carlo (runs,

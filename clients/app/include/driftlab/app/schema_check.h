@@ -15,6 +15,7 @@
 #include <google/protobuf/struct.pb.h>
 
 #include <string>
+#include <string_view>
 
 namespace driftlab::app {
 
@@ -34,5 +35,15 @@ inline constexpr int kMaxJobRepeatedFieldSize = 100000;
 
 // Throws SpecError naming the first field over a limit above (path, its size, the limit).
 void CheckFieldSizes(const google::protobuf::Message& message, const std::string& path = "");
+
+// The values of a parsed message, whatever way it arrived (a binary gRPC request carries what the
+// JSON check above never sees): no unknown field, every enum value one the schema defines, every
+// double and float finite. Throws SpecError naming the first offending field path.
+void CheckMessageValues(const google::protobuf::Message& message, const std::string& path = "");
+
+// True when `path` names a field of `descriptor`'s schema: dot-separated proto field names, each
+// repeated field optionally indexed ("motion.segments[2].turn.radius_m", "sensor.gyro.
+// fixed_bias_deg_per_h[1]"). Error messages name fields by such paths.
+bool IsSchemaFieldPath(const google::protobuf::Descriptor& descriptor, std::string_view path);
 
 }  // namespace driftlab::app

@@ -9,8 +9,10 @@
 #pragma once
 
 #include <filesystem>
+#include <vector>
 
 #include "driftlab/app/job_file.h"
+#include "driftlab/output_files.h"
 #include "driftlab/simulate.h"
 #include "driftlab/v1/job.pb.h"
 
@@ -20,10 +22,11 @@ namespace driftlab::app {
 // here; relative paths resolve against base_dir. Throws SpecError.
 SimulationSpec ToSimulationSpec(const v1::Job& job, const std::filesystem::path& base_dir);
 
-// Full validation of a job: ToSimulationSpec, then the engine's own checks that need the planned
-// motion (a static segment entered at speed, a turn by radius at zero speed, the total duration),
-// done by constructing the trajectory generator (plans the segments, generates no samples).
-// Returns the spec ready for RunErrorFreeSimulation. Throws SpecError.
-SimulationSpec ValidateJob(const JobFile& file);
+// The whole job's validation is ValidateJob (job_validator.h), which every entry calls.
+
+// The files a job reads besides the job file: its motion file (motion.gnss_ins_sim_file.path or
+// motion.truth_profile_file.path, resolved against base_dir as the translation resolves it), each
+// with its field path; empty for a motion of segments. For the commands' output checks.
+std::vector<CommandPath> JobInputFiles(const v1::Job& job, const std::filesystem::path& base_dir);
 
 }  // namespace driftlab::app
