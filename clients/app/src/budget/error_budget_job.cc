@@ -201,11 +201,18 @@ void CheckErrorBudget(const MonteCarloSpec& spec, const ErrorBudgetResult& budge
     v1::JobResult result;
   };
   std::vector<Pending> checks;
-  for (int i = 0; i < top && i < out->sources_size(); ++i) {
+  std::vector<std::vector<std::string>> sets_run;  // sorted switched-on sets already checked
+  for (int i = 0; static_cast<int>(checks.size()) < top && i < out->sources_size(); ++i) {
     const std::string& name = out->sources(i).name();
     Pending p;
     p.source = name;
     const MonteCarloSpec check = BudgetCheckSpec(spec, budget, name, runs, &p.on);
+    // A filter's aid and initial-error sources share one check (they stay on together): the
+    // next source with a set not yet run takes the place of a repeat.
+    std::vector<std::string> set = p.on;
+    std::sort(set.begin(), set.end());
+    if (std::find(sets_run.begin(), sets_run.end(), set) != sets_run.end()) continue;
+    sets_run.push_back(std::move(set));
     for (int c = 0; c < kCheckedComponents; ++c) {
       double variance = 0.0;
       for (size_t s = 0; s < budget.sources.size(); ++s) {

@@ -33,7 +33,8 @@ MonteCarloSpec BudgetCheckSpec(const MonteCarloSpec& spec, const ErrorBudgetResu
                                const std::string& source, uint32_t runs,
                                std::vector<std::string>* switched_on);
 
-// Runs the check of the `top` first sources of `out` (its sorted order) over `runs` runs each and
+// Runs the check of the `top` first sources of `out` (its sorted order; a source whose set of
+// switched-on sources equals an earlier check's is skipped for the next) over `runs` runs each and
 // fills out->checks, check_alpha and verdict. At the final epoch, for each of the 9 position,
 // velocity and attitude components with a predicted sigma > 0, the ratio of the Monte-Carlo
 // standard deviation to the predicted sigma of the switched-on sources gets its chi-square interval
