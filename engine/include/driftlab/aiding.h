@@ -211,6 +211,10 @@ class AidingSensor {
   // H and R at estimate.state (the filter's estimate, or the truth in the covariance analysis);
   // with estimate.first_state < 0 the sensor's own errors are not states and R holds them.
   virtual void Model(const AidingEstimate& estimate, AidingUpdate* update) const = 0;
+  // The term of the sensor's error model that makes row `row` of R (its white measurement noise,
+  // named for the error budget: "position_white"); R holds nothing else when the sensor's own
+  // errors are states.
+  virtual std::string NoiseTerm(int /*row*/) const { return "noise"; }
   // The sensor in run `run` of the job (seed).
   virtual std::unique_ptr<AidingRun> Start(const NavEnvironment& env, uint64_t seed,
                                            uint32_t run) const = 0;

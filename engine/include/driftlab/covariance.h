@@ -42,6 +42,15 @@ class ErrorCovariancePropagator {
   const ErrorStateMatrix& P() const { return P_; }
   ErrorStateMatrix& mutable_P() { return P_; }
 
+  // Independent error sources for the error budget (Gelb, "Applied Optimal Estimation", 1974,
+  // section 7.3): source s has its own covariance P_s (started at P0[s]) and its share q_c[s] of
+  // the diagonal of Q_c (the shares sum to the diagonal). Propagate then also steps every P_s with
+  // the same Phi and the Q_d of its share, P_s <- Phi P_s Phi^T + Q_d,s; Q_d is linear in Q_c, so
+  // sum_s P_s = P when sum_s P0[s] = P0 (to rounding). P itself is stepped as without sources.
+  void SetSources(std::vector<ErrorStateMatrix> P0, std::vector<Eigen::VectorXd> q_c);
+  const std::vector<ErrorStateMatrix>& source_P() const { return source_P_; }
+  std::vector<ErrorStateMatrix>& mutable_source_P() { return source_P_; }
+
  private:
   NavEnvironment env_;
   ErrorStateNoise noise_;
@@ -53,10 +62,25 @@ class ErrorCovariancePropagator {
   bool PropagateExactSeries(const ErrorStateMatrix& F, double dt_s);
   // P <- Phi P Phi^T + Q_d from Phi = [[A_, B_], [0, diag(d_)]] and the blocks of Q_d.
   void ApplyStructuredStep(const Eigen::MatrixXd& Qd_nn, const Eigen::MatrixXd& Qd_ns,
-                           const Eigen::VectorXd& Qd_ss);
+                           const Eigen::VectorXd& Qd_ss, ErrorStateMatrix* P);
+  // The sources' steps with the Phi of the step just taken (A_, B_, d_; Phi_ for the dense one).
+  void PropagateSourcesSecondOrder(double dt_s);
+  void PropagateSourcesSeries(double h);
+  void PropagateSourcesDense(const ErrorStateMatrix& F, double dt_s);
   // Work space of the structured step (allocated once).
   Eigen::MatrixXd A_, B_, BPss_, Pnn_, Pns_;
   Eigen::VectorXd d_, q_s_;
+  // The budget's sources: covariance, share of diag(Q_c), and the indices where the share is > 0.
+  std::vector<ErrorStateMatrix> source_P_;
+  std::vector<Eigen::VectorXd> source_q_;
+  std::vector<std::vector<int>> source_support_;
+  // The series terms of the last exact step (PropagateExactSeries), kept for the sources:
+  // N_k, U_k, and the weighted sums sum_j T_j / (i + j + 1) (N_sum, U_sum, G).
+  std::vector<Eigen::Matrix<double, kNumNavErrorStates, kNumNavErrorStates>> series_N_,
+      series_Nsum_;
+  std::vector<Eigen::MatrixXd> series_U_, series_Usum_;
+  std::vector<Eigen::VectorXd> series_G_;
+  Eigen::VectorXd series_Dh_;  // D h
 };
 
 // Predicted 1-sigma errors at one epoch, in the components the Monte-Carlo statistics report.
@@ -64,8 +88,8 @@ struct CovarianceEpoch {
   double t_s = 0.0;
   ErrorStateVector sigma;  // sqrt(diag P): r [m], v [m/s], psi [rad], b_a [m/s^2], b_g [rad/s],
                            //   then the augmented states (ErrorStateLayout)
-  Vector3d euler_sigma_rad = Vector3d::Zero();        // roll, pitch, yaw: sqrt(diag(T P_psi T^T))
-  double horizontal_sigma_m = 0.0;                    // sqrt(P_NN + P_EE) (RMS horizontal error)
+  Vector3d euler_sigma_rad = Vector3d::Zero();  // roll, pitch, yaw: sqrt(diag(T P_psi T^T))
+  double horizontal_sigma_m = 0.0;              // sqrt(P_NN + P_EE) (RMS horizontal error)
   ErrorStateMatrix P;
 };
 

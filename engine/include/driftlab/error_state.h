@@ -73,10 +73,15 @@ using ErrorStateMatrix = Eigen::MatrixXd;
 // Stochastic model of one bias process as the error state represents it (per axis, identical
 // axes, one state per axis): b' = -b / tau_s + w, PSD of w = driving_psd; tau_s = 0 means b' = w
 // (random walk, or a random constant when driving_psd = 0). initial_sigma is the 1-sigma at t = 0.
+// `source` says which terms of the IMU model (sensor_params.h) the state carries, for the error
+// budget (error_budget.h): the turn-on bias (its initial sigma) with the random walk (its drive),
+// a Gauss-Markov bias, or one state of the flicker bias instability.
+enum class BiasStateSource { kTurnOnAndRandomWalk, kGaussMarkov, kFlicker };
 struct BiasStateModel {
   double initial_sigma = 0.0;  // [u]
   double tau_s = 0.0;          // [s], 0 = no decay
   double driving_psd = 0.0;    // [u^2 / s]
+  BiasStateSource source = BiasStateSource::kTurnOnAndRandomWalk;
 };
 
 // Scale-factor and misalignment errors of one triad as augmented random-constant states: 3 scale
@@ -98,6 +103,7 @@ struct AidingErrorStates {
   std::string owner;          // the aid's field path ("aiding.gnss")
   std::vector<double> sigma;  // per state [the aid's unit]
   double tau_s = 0.0;         // correlation time [s]; 0 = random constant
+  std::string term;           // the aid's term the states carry ("position_gauss_markov")
 };
 
 // Noise model of the error model. Units: gyro u = rad/s, accelerometer u = m/s^2.

@@ -45,6 +45,8 @@
 
 namespace driftlab {
 
+struct ErrorBudgetRecord;  // error_budget.h
+
 struct InsGnssFilterOptions {
   ErrorStateNoise imu_noise;  // process noise and bias models (MakeErrorStateNoise)
   GnssConfig gnss;            // measurement noise, lever arm, use of velocity
@@ -123,12 +125,17 @@ class InsGnssFilter {
 // The gain is the one a filter running on the truth would use; for a consistent filter the
 // predicted sigma is the Monte-Carlo spread (Maybeck vol. 1, section 6.8; Gelb, "Applied Optimal
 // Estimation", section 7.1, covariance analysis).
+//
+// With `budget` (error_budget.h), the same pass also propagates each of budget->sources alone
+// with the same transitions and, at each update, the gain K of the full P (Gelb 1974, section
+// 7.3), and records every source's component variances at the epochs in budget->variances.
 std::vector<CovarianceEpoch> FilterCovarianceAnalysis(const MotionSpec& motion, double rate_hz,
                                                       const ErrorStateNoise& noise,
                                                       const ErrorStateMatrix& P0,
                                                       const AidingSchedule* schedule,
                                                       const std::vector<int64_t>& epoch_samples,
-                                                      int64_t step_samples, Discretization method);
+                                                      int64_t step_samples, Discretization method,
+                                                      ErrorBudgetRecord* budget = nullptr);
 
 // The normalised estimation error squared e^T P^-1 e (NEES) of an error state.
 double Nees(const ErrorStateVector& error, const ErrorStateMatrix& P);

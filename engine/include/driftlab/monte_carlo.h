@@ -23,6 +23,7 @@
 #include "driftlab/aiding.h"
 #include "driftlab/complementary_filter.h"
 #include "driftlab/covariance.h"
+#include "driftlab/error_budget.h"
 #include "driftlab/exact_sum.h"
 #include "driftlab/ins_gnss_filter.h"
 #include "driftlab/mc_statistics.h"
@@ -189,6 +190,27 @@ struct CovarianceAnalysisResult {
   std::vector<CovarianceEpoch> epochs;     // at the statistics' epoch times
   std::vector<std::string> unrepresented;  // model terms the prediction leaves out (paths)
 };
+
+// Error budget of a job (error_budget.h): the covariance analysis of `run --covariance`
+// (FilterCovarianceAnalysis with the same error-state model, P0, aiding schedule, propagation
+// interval and discretisation) with each independent error source also propagated alone, at the
+// job's output epochs. Component variances in SI (angles rad^2).
+struct ErrorBudgetResult {
+  NavigationFilterKind filter = NavigationFilterKind::kNone;
+  int64_t step_samples = 0;
+  std::vector<double> epoch_times_s;
+  std::vector<ErrorSource> sources;                           // names, groups (P0, q_c kept)
+  std::vector<ComponentVariances> total;                      // [epoch], of the full P
+  std::vector<std::vector<ComponentVariances>> contribution;  // [epoch][source]
+  std::vector<std::string> unrepresented;  // model terms the linear model leaves out (paths)
+  // max over epochs and components of |sum_s contribution - total| / total (total > 0).
+  double max_relative_sum_error = 0.0;
+};
+
+// Validates the job as RunMonteCarloWithAnalysis with the covariance analysis on (SpecError with
+// the field path), then computes the budget. A job whose filter assumes its own IMU model
+// (navigation.ekf.sensor) is refused: SpecError("navigation.ekf.sensor", ...).
+ErrorBudgetResult ComputeErrorBudget(const MonteCarloSpec& spec);
 
 struct MonteCarloOutput {
   MonteCarloStatistics statistics;

@@ -28,7 +28,7 @@ class BarometerSensor : public AidingSensor {
   int64_t decimation() const override { return decimation_; }
   std::vector<AidingErrorStates> ErrorStates() const override {
     if (!(config_.bias.sigma > 0.0)) return {};
-    return {AidingErrorStates{path_, {config_.bias.sigma}, config_.bias.tau_s}};
+    return {AidingErrorStates{path_, {config_.bias.sigma}, config_.bias.tau_s, "bias"}};
   }
   void Model(const AidingEstimate& e, AidingUpdate* u) const override {
     u->dim = 1;

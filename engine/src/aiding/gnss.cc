@@ -44,7 +44,13 @@ class GnssSensor : public AidingSensor {
   std::vector<AidingErrorStates> ErrorStates() const override {
     const Vector3d& s = config_.position_gauss_markov_sigma_ned_m;
     if (s.isZero(0.0)) return {};
-    return {AidingErrorStates{path_, {s.x(), s.y(), s.z()}, config_.position_gauss_markov_tau_s}};
+    return {AidingErrorStates{path_,
+                              {s.x(), s.y(), s.z()},
+                              config_.position_gauss_markov_tau_s,
+                              "position_gauss_markov"}};
+  }
+  std::string NoiseTerm(int row) const override {
+    return row < 3 ? "position_white" : "velocity_white";
   }
   void Model(const AidingEstimate& e, AidingUpdate* u) const override {
     GnssUpdate(config_, e, nullptr, u);

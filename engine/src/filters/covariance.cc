@@ -32,11 +32,15 @@ void ErrorCovariancePropagator::Propagate(const NavState& reference, const Vecto
                                           double dt_s, const Vector3d& omega_ib_b) {
   const ErrorStateMatrix F = ErrorStateSystemMatrix(env_, reference, f_ib_b, noise_, omega_ib_b);
   if (method_ == Discretization::kVanLoan) {
-    if (PropagateExactSeries(F, dt_s)) return;
+    if (PropagateExactSeries(F, dt_s)) {
+      PropagateSourcesSeries(dt_s);
+      return;
+    }
     ErrorStateMatrix Phi, Q_d;
     DiscretizeErrorModel(F, Q_c_, dt_s, method_, &Phi, &Q_d);
     P_ = (Phi * P_ * Phi.transpose()).eval() + Q_d;
     P_ = 0.5 * (P_ + P_.transpose()).eval();
+    PropagateSourcesDense(F, dt_s);
     return;
   }
   // Structured second-order step (see the header): nav block n = 9, sensor block m.
@@ -57,12 +61,111 @@ void ErrorCovariancePropagator::Propagate(const NavState& reference, const Vecto
                                  Eigen::Matrix<double, n, n>(q_n.asDiagonal()));
   const Eigen::MatrixXd Qd_ns = 0.5 * dt_s * BQ * d_.asDiagonal();
   const Eigen::VectorXd Qd_ss = 0.5 * dt_s * (d_.cwiseAbs2().cwiseProduct(q_s_) + q_s_);
-  ApplyStructuredStep(Qd_nn, Qd_ns, Qd_ss);
+  ApplyStructuredStep(Qd_nn, Qd_ns, Qd_ss, &P_);
+  PropagateSourcesSecondOrder(dt_s);
+}
+
+void ErrorCovariancePropagator::SetSources(std::vector<ErrorStateMatrix> P0,
+                                           std::vector<Eigen::VectorXd> q_c) {
+  if (P0.size() != q_c.size()) {
+    throw SpecError(
+        "covariance.sources",
+        std::to_string(P0.size()) + " P0, " + std::to_string(q_c.size()) + " Q_c shares",
+        "one share of each per source");
+  }
+  source_support_.clear();
+  for (size_t s = 0; s < P0.size(); ++s) {
+    if (P0[s].rows() != layout_.size || P0[s].cols() != layout_.size ||
+        q_c[s].size() != layout_.size) {
+      throw SpecError("covariance.sources", "source " + std::to_string(s) + " of the wrong size",
+                      std::to_string(layout_.size) + " states");
+    }
+    std::vector<int> support;
+    for (int i = 0; i < layout_.size; ++i) {
+      if (q_c[s][i] != 0.0) support.push_back(i);
+    }
+    source_support_.push_back(std::move(support));
+  }
+  source_P_ = std::move(P0);
+  source_q_ = std::move(q_c);
+}
+
+void ErrorCovariancePropagator::PropagateSourcesSecondOrder(double dt_s) {
+  // Q_d,s = dt / 2 (Phi Q_c,s Phi^T + Q_c,s) in blocks (Propagate), summed over the states j where
+  // the share q_j of source s is nonzero: Phi Q_c,s Phi^T = sum_j q_j Phi_(:,j) Phi_(:,j)^T.
+  constexpr int n = kNumNavErrorStates;
+  const int m = layout_.size - n;
+  Eigen::MatrixXd Qd_nn(n, n), Qd_ns(n, m);
+  Eigen::VectorXd Qd_ss(m);
+  for (size_t s = 0; s < source_P_.size(); ++s) {
+    Qd_nn.setZero();
+    Qd_ns.setZero();
+    Qd_ss.setZero();
+    for (const int j : source_support_[s]) {
+      const double w = 0.5 * dt_s * source_q_[s][j];
+      if (j < n) {
+        Qd_nn.noalias() += w * A_.col(j) * A_.col(j).transpose();
+        Qd_nn(j, j) += w;
+      } else {
+        const int c = j - n;
+        Qd_nn.noalias() += w * B_.col(c) * B_.col(c).transpose();
+        Qd_ns.col(c) += w * d_(c) * B_.col(c);
+        Qd_ss(c) += w * (d_(c) * d_(c) + 1.0);
+      }
+    }
+    ApplyStructuredStep(Qd_nn, Qd_ns, Qd_ss, &source_P_[s]);
+  }
+}
+
+void ErrorCovariancePropagator::PropagateSourcesSeries(double h) {
+  // Q_d,s of the exact step (PropagateExactSeries) for the share q of source s, per state j with
+  // q_j != 0: nn += h q_j sum_i N_i(:,j) N_sum_i(:,j)^T (j < 9), or for a sensor state c = j - 9
+  // nn += h q_j sum_i U_i(:,c) U_sum_i(:,c)^T, ns(:,c) = h q_j sum_i U_i(:,c) G_i(c),
+  // ss(c) = q_j h expm1(2 D_c h) / (2 D_c h).
+  constexpr int n = kNumNavErrorStates;
+  const int m = layout_.size - n;
+  const int K = static_cast<int>(series_N_.size());
+  Eigen::MatrixXd Qd_nn(n, n), Qd_ns(n, m);
+  Eigen::VectorXd Qd_ss(m);
+  for (size_t s = 0; s < source_P_.size(); ++s) {
+    Qd_nn.setZero();
+    Qd_ns.setZero();
+    Qd_ss.setZero();
+    for (const int j : source_support_[s]) {
+      const double w = h * source_q_[s][j];
+      if (j < n) {
+        for (int i = 0; i < K; ++i) {
+          Qd_nn.noalias() += w * series_N_[i].col(j) * series_Nsum_[i].col(j).transpose();
+        }
+      } else {
+        const int c = j - n;
+        for (int i = 1; i < K; ++i) {
+          Qd_nn.noalias() += w * series_U_[i].col(c) * series_Usum_[i].col(c).transpose();
+          Qd_ns.col(c) += w * series_G_[i](c) * series_U_[i].col(c);
+        }
+        const double x = 2.0 * series_Dh_(c);
+        Qd_ss(c) = w * (x == 0.0 ? 1.0 : math::Expm1(x) / x);
+      }
+    }
+    ApplyStructuredStep(Qd_nn, Qd_ns, Qd_ss, &source_P_[s]);
+  }
+}
+
+void ErrorCovariancePropagator::PropagateSourcesDense(const ErrorStateMatrix& F, double dt_s) {
+  for (size_t s = 0; s < source_P_.size(); ++s) {
+    ErrorStateMatrix Phi, Q_d;
+    DiscretizeErrorModel(F, ErrorStateMatrix(source_q_[s].asDiagonal()), dt_s, method_, &Phi, &Q_d);
+    ErrorStateMatrix& P = source_P_[s];
+    P = (Phi * P * Phi.transpose()).eval() + Q_d;
+    P = 0.5 * (P + P.transpose()).eval();
+  }
 }
 
 void ErrorCovariancePropagator::ApplyStructuredStep(const Eigen::MatrixXd& Qd_nn,
                                                     const Eigen::MatrixXd& Qd_ns,
-                                                    const Eigen::VectorXd& Qd_ss) {
+                                                    const Eigen::VectorXd& Qd_ss,
+                                                    ErrorStateMatrix* P) {
+  ErrorStateMatrix& P_ = *P;
   // P <- Phi P Phi^T + Q_d with Phi = [[A, B], [0, diag(d)]] and P = [[P_nn, P_ns], [P_ns^T,
   // P_ss]].
   constexpr int n = kNumNavErrorStates;
@@ -134,6 +237,14 @@ bool ErrorCovariancePropagator::PropagateExactSeries(const ErrorStateMatrix& F, 
   // ns = h sum_i U_i diag(q_s G_i), G_i = sum_j E_j / (i + j + 1) = int_0^1 s^i exp(D h s) ds.
   Eigen::MatrixXd Qd_nn = Eigen::MatrixXd::Zero(n, n);
   Eigen::MatrixXd Qd_ns = Eigen::MatrixXd::Zero(n, m);
+  if (!source_P_.empty()) {
+    series_N_ = N;
+    series_U_ = U;
+    series_Dh_ = Dh;
+    series_Nsum_.resize(K);
+    series_Usum_.resize(K);
+    series_G_.resize(K);
+  }
   for (int i = 0; i < K; ++i) {
     Eigen::Matrix<double, n, n> N_sum = Eigen::Matrix<double, n, n>::Zero();
     Eigen::MatrixXd U_sum = Eigen::MatrixXd::Zero(n, m);
@@ -145,6 +256,11 @@ bool ErrorCovariancePropagator::PropagateExactSeries(const ErrorStateMatrix& F, 
       G += w * E[j];
     }
     Qd_nn += N[i] * q_n.asDiagonal() * N_sum.transpose();
+    if (!source_P_.empty()) {
+      series_Nsum_[i] = N_sum;
+      series_Usum_[i] = U_sum;
+      series_G_[i] = G;
+    }
     if (i > 0) {
       Qd_nn += U[i] * q_s_.asDiagonal() * U_sum.transpose();
       Qd_ns += U[i] * q_s_.cwiseProduct(G).asDiagonal();
@@ -158,7 +274,7 @@ bool ErrorCovariancePropagator::PropagateExactSeries(const ErrorStateMatrix& F, 
     const double x = 2.0 * Dh(j);
     Qd_ss(j) = q_s_(j) * h * (x == 0.0 ? 1.0 : math::Expm1(x) / x);
   }
-  ApplyStructuredStep(Qd_nn, Qd_ns, Qd_ss);
+  ApplyStructuredStep(Qd_nn, Qd_ns, Qd_ss, &P_);
   return true;
 }
 

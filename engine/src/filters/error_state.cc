@@ -32,6 +32,7 @@ void BiasModelOf(const TriadErrorParams& p, const std::string& path,
     // bias started at 0 (gnss-ins-sim's convention) has no initial uncertainty.
     gm_state.initial_sigma = p.bias_gauss_markov.start_at_zero ? 0.0 : p.bias_gauss_markov.sigma;
     gm_state.tau_s = p.bias_gauss_markov.tau_s;
+    gm_state.source = BiasStateSource::kGaussMarkov;
     gm_state.driving_psd =
         2.0 * p.bias_gauss_markov.sigma * p.bias_gauss_markov.sigma / p.bias_gauss_markov.tau_s;
   }
@@ -145,6 +146,7 @@ std::vector<BiasStateModel> FitFlickerStates(const FlickerParams& flicker, int c
     b.initial_sigma = std::sqrt(variance);  // the simulator starts flicker stationary
     b.tau_s = tau_s;
     b.driving_psd = 2.0 * variance / tau_s;
+    b.source = BiasStateSource::kFlicker;
     return b;
   };
   if (design.empty()) return out;

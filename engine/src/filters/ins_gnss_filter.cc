@@ -7,6 +7,7 @@
 
 #include "driftlab/attitude.h"
 #include "driftlab/elementary.h"
+#include "driftlab/error_budget.h"
 #include "driftlab/spec_error.h"
 #include "driftlab/trajectory.h"
 
@@ -189,7 +190,8 @@ std::vector<CovarianceEpoch> FilterCovarianceAnalysis(const MotionSpec& motion, 
                                                       const ErrorStateMatrix& P0,
                                                       const AidingSchedule* schedule,
                                                       const std::vector<int64_t>& epoch_samples,
-                                                      int64_t step_samples, Discretization method) {
+                                                      int64_t step_samples, Discretization method,
+                                                      ErrorBudgetRecord* budget) {
   if (step_samples < 1 || step_samples > 10000) {
     throw SpecError("monte_carlo.covariance_step_samples", std::to_string(step_samples),
                     "[1, 10000]");
@@ -199,6 +201,43 @@ std::vector<CovarianceEpoch> FilterCovarianceAnalysis(const MotionSpec& motion, 
   const double dt = generator.dt_s();
   ErrorCovariancePropagator prop(env, noise, P0, method);
   const ErrorStateLayout& layout = prop.layout();
+  // The budget's sources: their P0 and Q_c shares, and per aid the rows of R each owns.
+  std::vector<std::vector<uint32_t>> source_rows;  // [aid][source]
+  if (budget != nullptr) {
+    std::vector<ErrorStateMatrix> source_P0;
+    std::vector<Eigen::VectorXd> source_q;
+    for (const ErrorSource& s : budget->sources) {
+      source_P0.push_back(s.P0);
+      source_q.push_back(s.q_c);
+    }
+    prop.SetSources(std::move(source_P0), std::move(source_q));
+    budget->variances.clear();
+    if (schedule != nullptr) {
+      for (const auto& sensor : schedule->sensors()) {
+        std::vector<uint32_t> rows;
+        for (const ErrorSource& s : budget->sources) {
+          uint32_t mask = 0;
+          for (int r = 0; s.aid == sensor->path() && r < AidingUpdate::kMaxDim; ++r) {
+            if (sensor->NoiseTerm(r) == s.aid_term) mask |= 1u << r;
+          }
+          rows.push_back(mask);
+        }
+        source_rows.push_back(std::move(rows));
+      }
+    }
+  }
+  std::vector<CovarianceEpoch> out;
+  out.reserve(epoch_samples.size());
+  auto record = [&](const NavState& truth) {
+    out.push_back(MakeCovarianceEpoch(truth.t_s, prop.P(), truth.euler()));
+    if (budget == nullptr) return;
+    std::vector<ComponentVariances> v;
+    v.reserve(prop.source_P().size());
+    for (const ErrorStateMatrix& P_s : prop.source_P()) {
+      v.push_back(ComponentVariancesOf(P_s, truth.euler()));
+    }
+    budget->variances.push_back(std::move(v));
+  };
   std::vector<int> first_state;
   if (schedule != nullptr) {
     for (const auto& sensor : schedule->sensors()) {
@@ -206,12 +245,10 @@ std::vector<CovarianceEpoch> FilterCovarianceAnalysis(const MotionSpec& motion, 
     }
   }
 
-  std::vector<CovarianceEpoch> out;
-  out.reserve(epoch_samples.size());
   size_t next_epoch = 0;
   const NavState& truth0 = generator.initial_state();
   if (next_epoch < epoch_samples.size() && epoch_samples[next_epoch] == 0) {
-    out.push_back(MakeCovarianceEpoch(truth0.t_s, prop.P(), truth0.euler()));
+    record(truth0);
     ++next_epoch;
   }
   Matrix3d C_prev = truth0.C_b_n();
@@ -239,7 +276,7 @@ std::vector<CovarianceEpoch> FilterCovarianceAnalysis(const MotionSpec& motion, 
       pending = 0;
     }
     if (epoch) {
-      out.push_back(MakeCovarianceEpoch(truth.t_s, prop.P(), truth.euler()));
+      record(truth);
       ++next_epoch;
     }
     for (size_t i = 0; due != 0 && i < first_state.size(); ++i) {
@@ -252,22 +289,31 @@ std::vector<CovarianceEpoch> FilterCovarianceAnalysis(const MotionSpec& motion, 
       e.first_state = first_state[i];
       AidingUpdate u;
       schedule->sensors()[i]->Model(e, &u);
+      Eigen::MatrixXd K;
       switch (u.dim) {
         case 1:
-          JosephUpdate<1>(u.H.topRows<1>(), u.R.topLeftCorner<1, 1>(), &prop.mutable_P());
+          K = JosephUpdate<1>(u.H.topRows<1>(), u.R.topLeftCorner<1, 1>(), &prop.mutable_P());
           break;
         case 2:
-          JosephUpdate<2>(u.H.topRows<2>(), u.R.topLeftCorner<2, 2>(), &prop.mutable_P());
+          K = JosephUpdate<2>(u.H.topRows<2>(), u.R.topLeftCorner<2, 2>(), &prop.mutable_P());
           break;
         case 3:
-          JosephUpdate<3>(u.H.topRows<3>(), u.R.topLeftCorner<3, 3>(), &prop.mutable_P());
+          K = JosephUpdate<3>(u.H.topRows<3>(), u.R.topLeftCorner<3, 3>(), &prop.mutable_P());
           break;
         case 6:
-          JosephUpdate<6>(u.H, u.R, &prop.mutable_P());
+          K = JosephUpdate<6>(u.H, u.R, &prop.mutable_P());
           break;
         default:
           throw SpecError(schedule->sensors()[i]->path(), std::to_string(u.dim) + " rows",
                           "1, 2, 3 or 6 measurement rows");
+      }
+      if (budget != nullptr) {
+        // The sources' updates with the full filter's gain K (computed before P was updated).
+        const Eigen::MatrixXd H = u.H.topRows(u.dim);
+        const Eigen::MatrixXd R = u.R.topLeftCorner(u.dim, u.dim);
+        for (size_t s = 0; s < prop.source_P().size(); ++s) {
+          SourceJosephUpdate(H, R, K, source_rows[i][s], &prop.mutable_source_P()[s]);
+        }
       }
     }
   }

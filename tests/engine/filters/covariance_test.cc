@@ -226,8 +226,9 @@ StructuredCase MakeStructuredCase() {
   ErrorModelOptions three;
   three.flicker_states_per_axis = 3;
   c.noise = MakeErrorStateNoise(FindImuPreset("tactical"), "sensor", three).noise;
-  c.noise.aiding_states.push_back(AidingErrorStates{"aiding.gnss", {0.5, 0.5, 1.0}, 100.0});
-  c.noise.aiding_states.push_back(AidingErrorStates{"aiding.barometer", {2.0}, 300.0});
+  c.noise.aiding_states.push_back(
+      AidingErrorStates{"aiding.gnss", {0.5, 0.5, 1.0}, 100.0, "position_gauss_markov"});
+  c.noise.aiding_states.push_back(AidingErrorStates{"aiding.barometer", {2.0}, 300.0, "bias"});
   const int n = ErrorStateLayout(c.noise).size;
   Eigen::MatrixXd A = Eigen::MatrixXd::Random(n, n) * 1e-3;
   c.P0 = A * A.transpose() + InitialErrorCovariance(Vector3d(1, 1, 2), Vector3d(0.1, 0.1, 0.1),
