@@ -9,12 +9,15 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "commands.h"
 #include "driftlab/app/error_budget_job.h"
 #include "driftlab/app/job_file.h"
+#include "driftlab/app/job_validator.h"
 #include "driftlab/app/monte_carlo_job.h"
 #include "driftlab/app/result_file.h"
+#include "driftlab/app/translate.h"
 #include "driftlab/report/budget_report.h"
 #include "driftlab/spec_error.h"
 
@@ -69,14 +72,14 @@ int RunBudget(const BudgetOptions& options) {
   MonteCarloSpec spec;
   try {
     file = app::LoadJobFile(options.job_path);
-    app::MonteCarloOverrides overrides;
-    overrides.seed = options.seed;
-    overrides.threads = options.threads;
-    if (!OutputPathUsable(options.out, "--out") ||
-        (options.report && !OutputPathUsable(*options.report, "--report"))) {
-      return kExitBadJob;
-    }
-    spec = app::ToMonteCarloSpec(file, overrides);
+    app::JobValidationOptions validation;
+    validation.overrides.seed = options.seed;
+    validation.overrides.threads = options.threads;
+    std::vector<CommandPath> inputs = {{options.job_path, "JOB"}};
+    for (const CommandPath& p : app::JobInputFiles(file.job, file.base_dir)) inputs.push_back(p);
+    CheckCommandOutputs(inputs, {{options.out, "--out"}, {options.report.value_or(""), "--report"}},
+                        /*creates_directories=*/true);
+    spec = app::ValidateJob(file, validation).spec;
   } catch (const SpecError& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadJob;
