@@ -230,21 +230,19 @@ TrajectoryGenerator::TrajectoryGenerator(const MotionSpec& motion, double rate_h
   } else {
     m.env = NavEnvironment::Wgs84();
   }
+  std::vector<SegmentOrigin> origins;
   if (motion.truth_profile.empty()) {
     Planner planner(motion, m.env, rate_hz, &m.pieces, &m.gps_invisible_s);
     planner.Plan();
     m.duration_s = planner.duration();
-    CheckPlannedKinematics(m.pieces, planner.origins(), &m.euler_singularity);
+    origins = planner.origins();
   } else {
     PlanTruthProfile(motion, &m.pieces);
     m.duration_s = m.pieces.back().t1;
-    std::vector<SegmentOrigin> origins;
     for (size_t i = 0; i < m.pieces.size(); ++i) {
       origins.push_back(SegmentOrigin{
           m.pieces[i].t0, motion.field_path + ".truth_profile[" + std::to_string(i) + "]"});
     }
-    CheckPlannedKinematics(m.pieces, origins, &m.euler_singularity);
-    CheckTruthProfilePositions(motion, m.env, m.pieces);
   }
   if (m.pieces.empty() || !(m.duration_s > 0.0)) {
     RejectText(motion.field_path + ".segments",
@@ -261,6 +259,9 @@ TrajectoryGenerator::TrajectoryGenerator(const MotionSpec& motion, double rate_h
            "a total duration of at least one output interval, 1 / rate_hz = " +
                CompactText(m.dt_s) + " s");
   }
+  // After the duration checks: the limits are checked at every sub-step of the motion.
+  CheckPlannedKinematics(m.pieces, origins, &m.euler_singularity);
+  if (!motion.truth_profile.empty()) CheckTruthProfilePositions(motion, m.env, m.pieces);
   for (size_t i = 1; i < m.pieces.size(); ++i) m.breakpoints.push_back(m.pieces[i].t0);
   while (!m.gps_invisible_s.empty() && m.gps_invisible_s.back().first >= m.duration_s) {
     m.gps_invisible_s.pop_back();  // only the dropped last step
