@@ -23,4 +23,22 @@ inline double SampleCorrelation(const std::vector<double>& a, const std::vector<
       cov / std::sqrt((saa / n - (sa / n) * (sa / n)) * (sbb / n - (sb / n) * (sb / n))));
 }
 
+// Standard normal quantile: bisection on erfc (to 1e-12; plenty for test bounds).
+inline double NormalQuantile(double p) {
+  double lo = -10.0, hi = 10.0;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (0.5 * std::erfc(-mid / std::sqrt(2.0)) < p ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+// Chi-square quantile by Wilson-Hilferty (relative error < 1e-3 for k >= 30; Johnson, Kotz &
+// Balakrishnan vol. 1, 18.5).
+inline double Chi2Quantile(double k, double p) {
+  const double z = NormalQuantile(p);
+  const double a = 2.0 / (9.0 * k);
+  return k * std::pow(1.0 - a + z * std::sqrt(a), 3);
+}
+
 }  // namespace driftlab::testing

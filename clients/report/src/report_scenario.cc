@@ -1,6 +1,7 @@
 #include "report_scenario.h"
 
 #include <fmt/format.h>
+#include <google/protobuf/text_format.h>
 
 #include <algorithm>
 #include <cmath>
@@ -56,6 +57,55 @@ std::string TriadFigures(const ImuErrorModel& model, SensorTriad t) {
   return parts.empty() ? "ideal" : fmt::format("{}", fmt::join(parts, ", "));
 }
 
+// One aid of the job, named by its field, with the values the job sets for it (the defaults of the
+// rest: docs/aiding.md), read by reflection so that a new aid needs no line here.
+std::string AidText(const google::protobuf::Message& aid, const std::string& name) {
+  using google::protobuf::FieldDescriptor;
+  const google::protobuf::Reflection* r = aid.GetReflection();
+  std::vector<const FieldDescriptor*> fields;
+  r->ListFields(aid, &fields);
+  std::vector<std::string> values;
+  for (const FieldDescriptor* f : fields) {
+    std::string v;
+    if (f->is_repeated()) {
+      if (f->cpp_type() != FieldDescriptor::CPPTYPE_DOUBLE) {
+        v = fmt::format("{} entries", r->FieldSize(aid, f));
+      } else {
+        std::vector<std::string> items;
+        for (int i = 0; i < r->FieldSize(aid, f); ++i) {
+          items.push_back(Num(r->GetRepeatedDouble(aid, f, i)));
+        }
+        v = fmt::format("[{}]", fmt::join(items, ", "));
+      }
+    } else {
+      switch (f->cpp_type()) {
+        case FieldDescriptor::CPPTYPE_DOUBLE:
+          v = Num(r->GetDouble(aid, f));
+          break;
+        case FieldDescriptor::CPPTYPE_BOOL:
+          v = r->GetBool(aid, f) ? "true" : "false";
+          break;
+        case FieldDescriptor::CPPTYPE_ENUM:
+          v = r->GetEnum(aid, f)->name();
+          break;
+        case FieldDescriptor::CPPTYPE_INT32:
+        case FieldDescriptor::CPPTYPE_UINT32:
+        case FieldDescriptor::CPPTYPE_INT64:
+        case FieldDescriptor::CPPTYPE_UINT64: {
+          std::string text;
+          google::protobuf::TextFormat::PrintFieldValueToString(aid, f, -1, &text);
+          v = text;
+          break;
+        }
+        default:
+          continue;  // nested messages: named by the aid's page, not repeated here
+      }
+    }
+    values.push_back(fmt::format("{} {}", f->name(), v));
+  }
+  return values.empty() ? name : fmt::format("{} ({})", name, fmt::join(values, ", "));
+}
+
 std::string AidingText(const v1::Job& job) {
   std::vector<std::string> parts;
   const v1::Aiding& a = job.aiding();
@@ -64,9 +114,18 @@ std::string AidingText(const v1::Job& job) {
         "GNSS at {} Hz{}", Num(a.gnss().has_rate_hz() ? a.gnss().rate_hz() : 1.0),
         a.gnss().outages().empty() ? "" : fmt::format(", {} outage(s)", a.gnss().outages_size())));
   }
-  if (a.has_barometer()) parts.push_back("barometer");
-  if (a.has_magnetometer()) parts.push_back("magnetometer");
   if (a.zupt().enabled()) parts.push_back("ZUPT while static");
+  // The other aids: every set field of the job's aiding section in the schema's order.
+  const google::protobuf::Reflection* r = a.GetReflection();
+  std::vector<const google::protobuf::FieldDescriptor*> fields;
+  r->ListFields(a, &fields);
+  for (const google::protobuf::FieldDescriptor* f : fields) {
+    if (f->name() == "gnss" || f->name() == "zupt" ||
+        f->cpp_type() != google::protobuf::FieldDescriptor::CPPTYPE_MESSAGE) {
+      continue;
+    }
+    parts.push_back(AidText(r->GetMessage(a, f), f->name()));
+  }
   return parts.empty() ? "none (free inertial)" : fmt::format("{}", fmt::join(parts, ", "));
 }
 

@@ -1,6 +1,6 @@
 // The aiding sensors of the navigation filters and the one schedule of their measurements.
 //
-// Each aiding sensor of the INS/GNSS EKF (GNSS gnss.h, barometer, ZUPT) is an
+// Each aiding sensor of the INS/GNSS EKF (GNSS gnss.h, barometer, ZUPT, odometer) is an
 // AidingSensor: its validated configuration, its epochs (a decimation of the IMU rate, gated by
 // GNSS outages or by the ZUPT static windows), its own error states (ErrorStates), and its
 // measurement model (Model: H and R), in its own file under engine/src/aiding/. The EKF
@@ -78,13 +78,27 @@ struct ZuptConfig {
   double velocity_sigma_m_per_s = 0.01;  // per axis
 };
 
+// Odometer and non-holonomic constraints of a ground vehicle (odometer.cc: the model, Groves 2nd
+// ed. section 16.3): the forward speed of the reference point at lever_arm_b_m with a per-run
+// scale-factor error and white noise, and (non_holonomic) zero lateral and vertical velocity of
+// that point with white residual motion.
+struct OdometerConfig {
+  double rate_hz = 10.0;                      // must divide the IMU rate
+  double speed_sigma_m_per_s = 0.05;          // white, per epoch
+  double scale_factor_sigma = 0.0;            // 1 sigma of the run's constant [-]; 0 = none
+  Vector3d lever_arm_b_m = Vector3d::Zero();  // reference point relative to the IMU, body [m]
+  bool non_holonomic = true;                  // the constraints as measurements
+  double non_holonomic_sigma_m_per_s = 0.1;   // white, per epoch and axis
+};
+
 // The aiding a Monte-Carlo job configures (absent = not used).
 struct AidingSpec {
   std::optional<GnssConfig> gnss;
   std::optional<BarometerConfig> barometer;
   std::optional<MagnetometerConfig> magnetometer;
   std::optional<ZuptConfig> zupt;
-  bool empty() const { return !gnss && !barometer && !magnetometer && !zupt; }
+  std::optional<OdometerConfig> odometer;
+  bool empty() const { return !gnss && !barometer && !magnetometer && !zupt && !odometer; }
 };
 
 // IMU samples per aiding epoch: imu_rate_hz / rate_hz, rounded. Throws SpecError naming `field`
@@ -99,6 +113,8 @@ void ValidateMagnetometerConfig(const MagnetometerConfig& config, double imu_rat
                                 const std::string& path = "aiding.magnetometer");
 void ValidateZuptConfig(const ZuptConfig& config, double imu_rate_hz,
                         const std::string& path = "aiding.zupt");
+void ValidateOdometerConfig(const OdometerConfig& config, double imu_rate_hz,
+                            const std::string& path = "aiding.odometer");
 // All configured aids; the GNSS outages must also end by duration_s (the trajectory's end;
 // negative = not checked): "aiding.gnss.outages[i].end_s".
 void ValidateAidingSpec(const AidingSpec& aiding, double imu_rate_hz, double duration_s);
@@ -222,7 +238,7 @@ class AidingSensor {
 
 using AidingSensors = std::vector<std::shared_ptr<const AidingSensor>>;
 
-// The EKF's aids of `aiding` (GNSS, barometer, ZUPT: those configured, in this order,
+// The EKF's aids of `aiding` (GNSS, barometer, ZUPT, odometer: those configured, in this order,
 // the order of their updates at a sample), validated against the IMU rate (SpecError naming the
 // field). The magnetometer is not among them (complementary filter).
 AidingSensors MakeAidingSensors(const AidingSpec& aiding, double imu_rate_hz);
@@ -237,6 +253,9 @@ std::shared_ptr<const AidingSensor> MakeBarometerSensor(
     const std::string& path = "aiding.barometer");
 std::shared_ptr<const AidingSensor> MakeZuptSensor(const ZuptConfig& config, double imu_rate_hz,
                                                    const std::string& path = "aiding.zupt");
+std::shared_ptr<const AidingSensor> MakeOdometerSensor(const OdometerConfig& config,
+                                                       double imu_rate_hz,
+                                                       const std::string& path = "aiding.odometer");
 
 // The one aiding schedule of a job: which aid measures at which IMU sample k in [first_k, n]:
 // aid i at the multiples of its decimation, where it is Available (GNSS outages) and, for the

@@ -26,6 +26,7 @@ AidingSensors MakeAidingSensors(const AidingSpec& a, double imu_rate_hz) {
   if (a.gnss) out.push_back(MakeGnssSensor(*a.gnss, imu_rate_hz));
   if (a.barometer) out.push_back(MakeBarometerSensor(*a.barometer, imu_rate_hz));
   if (a.zupt) out.push_back(MakeZuptSensor(*a.zupt, imu_rate_hz));
+  if (a.odometer) out.push_back(MakeOdometerSensor(*a.odometer, imu_rate_hz));
   return out;
 }
 
@@ -34,6 +35,7 @@ std::vector<std::string> AidingSensorPaths(const AidingSpec& a) {
   if (a.gnss) out.emplace_back("aiding.gnss");
   if (a.barometer) out.emplace_back("aiding.barometer");
   if (a.zupt) out.emplace_back("aiding.zupt");
+  if (a.odometer) out.emplace_back("aiding.odometer");
   return out;
 }
 

@@ -35,29 +35,15 @@
 #include "driftlab/app/monte_carlo_job.h"
 #include "driftlab/ins_gnss_filter.h"
 #include "driftlab/monte_carlo.h"
+#include "support/sample_statistics.h"
 
 namespace driftlab::app {
 namespace {
 
 constexpr int kAidedRuns = 500;
 
-// Standard normal quantile: bisection on erfc (to 1e-12; plenty for test bounds).
-double NormalQuantile(double p) {
-  double lo = -10.0, hi = 10.0;
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (0.5 * std::erfc(-mid / std::sqrt(2.0)) < p ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
-
-// Chi-square quantile by Wilson-Hilferty (relative error < 1e-3 for k >= 30; Johnson, Kotz &
-// Balakrishnan vol. 1, 18.5).
-double Chi2Quantile(double k, double p) {
-  const double z = NormalQuantile(p);
-  const double a = 2.0 / (9.0 * k);
-  return k * std::pow(1.0 - a + z * std::sqrt(a), 3);
-}
+using testing::Chi2Quantile;
+using testing::NormalQuantile;
 
 // The example job, reduced to the sensor terms the 15-state model represents (flicker bias
 // instability, scale factor and misalignment off: error_state.h lists them as unrepresented), with

@@ -177,6 +177,26 @@ ZuptConfig ToZuptConfig(const v1::ZuptAiding& in, double rate_hz) {
   return z;
 }
 
+OdometerConfig ToOdometerConfig(const v1::OdometerAiding& in, double rate_hz) {
+  const std::string p = "aiding.odometer";
+  OdometerConfig o;
+  o.rate_hz = AidingRate(p + ".rate_hz", in.has_rate_hz(), in.rate_hz(), 10.0, rate_hz);
+  o.speed_sigma_m_per_s =
+      OptionalOr(p + ".speed_sigma_m_per_s", in.has_speed_sigma_m_per_s(), in.speed_sigma_m_per_s(),
+                 o.speed_sigma_m_per_s, Positive(10.0, "m/s"));
+  o.scale_factor_sigma =
+      1e-6 * OptionalOr(p + ".scale_factor_sigma_ppm", in.has_scale_factor_sigma_ppm(),
+                        in.scale_factor_sigma_ppm(), 0.0, Closed(0.0, 100000.0, "ppm"));
+  o.lever_arm_b_m = Vector3Or(in.lever_arm_b_m(), p + ".lever_arm_b_m", Closed(-100.0, 100.0, "m"),
+                              Eigen::Vector3d::Zero());
+  o.non_holonomic = !in.has_non_holonomic() || in.non_holonomic();
+  o.non_holonomic_sigma_m_per_s = OptionalOr(
+      p + ".non_holonomic_sigma_m_per_s", in.has_non_holonomic_sigma_m_per_s(),
+      in.non_holonomic_sigma_m_per_s(), o.non_holonomic_sigma_m_per_s, Positive(10.0, "m/s"));
+  ValidateOdometerConfig(o, rate_hz, p);
+  return o;
+}
+
 // navigation.filter / ekf / complementary, aiding and the covariance switch.
 void TranslateFilterAndAiding(const v1::Job& job, const MonteCarloOverrides& overrides,
                               MonteCarloSpec* spec) {
@@ -290,6 +310,7 @@ void TranslateFilterAndAiding(const v1::Job& job, const MonteCarloOverrides& ove
   if (aiding.has_zupt() && aiding.zupt().enabled()) {
     spec->aiding.zupt = ToZuptConfig(aiding.zupt(), rate_hz);
   }
+  if (aiding.has_odometer()) spec->aiding.odometer = ToOdometerConfig(aiding.odometer(), rate_hz);
 
   const v1::MonteCarlo& mc = job.monte_carlo();
   spec->covariance = overrides.covariance || (mc.has_covariance() && mc.covariance());
