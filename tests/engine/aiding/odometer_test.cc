@@ -42,7 +42,8 @@ struct Case {
     state.v_eb_n = Vector3d(8.0, -5.0, 0.3);
     state.q_b_n = Quaterniond(EulerToDcm(EulerAngles{3.0 * kDeg, -2.0 * kDeg, 150.0 * kDeg}));
     noise = MakeErrorStateNoise(FindImuPreset("tactical")).noise;
-    noise.aiding_states.push_back(AidingErrorStates{"aiding.odometer", {0.002}, 0.0});
+    noise.aiding_states.push_back(
+        AidingErrorStates{"aiding.odometer", {0.002}, 0.0, "scale_factor"});
   }
 };
 
