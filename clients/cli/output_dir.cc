@@ -19,10 +19,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string Quoted(const fs::path& path) {
-  return "'" + MessageText(path.string(), kMaxMessageValueBytes) + "'";
-}
-
 }  // namespace
 
 OutputDirectory::OutputDirectory(const fs::path& dir, const std::string& option,
@@ -32,7 +28,7 @@ OutputDirectory::OutputDirectory(const fs::path& dir, const std::string& option,
   if (dir.empty()) throw SpecError(option, "''", "a directory path");
   struct stat st {};
   if (::stat(dir.c_str(), &st) == 0 && !S_ISDIR(st.st_mode)) {
-    throw SpecError(option, Quoted(dir) + " (not a directory)",
+    throw SpecError(option, PathsInMessage("{} (not a directory)", {dir}),
                     "a directory, or a path where one can be created");
   }
   std::vector<CommandPath> outputs;
@@ -55,7 +51,8 @@ OutputDirectory::OutputDirectory(const fs::path& dir, const std::string& option,
       RemoveTemporary();
       throw SpecError(
           option,
-          Quoted(dir) + " (cannot create " + Quoted(p) + ": " + std::strerror(error_number) + ")",
+          PathsInMessage(std::string("{} (cannot create {}: ") + std::strerror(error_number) + ")",
+                         {dir, p}),
           "a directory, or a path where one can be created");
     }
     created_.push_back(p);
@@ -66,10 +63,11 @@ OutputDirectory::OutputDirectory(const fs::path& dir, const std::string& option,
   if (::mkdtemp(name.data()) == nullptr) {
     const int error_number = errno;
     RemoveTemporary();
-    throw SpecError(
-        option,
-        Quoted(dir) + " (cannot create a directory in it: " + std::strerror(error_number) + ")",
-        "a directory where files can be created");
+    throw SpecError(option,
+                    PathsInMessage(std::string("{} (cannot create a directory in it: ") +
+                                       std::strerror(error_number) + ")",
+                                   {dir}),
+                    "a directory where files can be created");
   }
   temporary_ = name.data();
 }
@@ -84,7 +82,7 @@ void OutputDirectory::Commit() {
   const auto fail = [this](const std::string& what, int error_number) {
     RemoveTemporary();
     throw OutputError(MessageText(option_, kMaxMessageFieldBytes) + ": cannot write " +
-                      Quoted(dir_) + ": " + what +
+                      QuotedPath(dir_, kMaxMessageValueBytes) + ": " + what +
                       (error_number != 0 ? std::string(" (") + std::strerror(error_number) + ")"
                                          : std::string()));
   };
@@ -92,7 +90,7 @@ void OutputDirectory::Commit() {
   for (const std::string& name : names_) {
     struct stat st {};
     if (::lstat((dir_ / name).c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
-      fail(Quoted(dir_ / name) + " is no longer a regular file", 0);
+      fail(QuotedPath(dir_ / name, kMaxMessageValueBytes) + " is no longer a regular file", 0);
     }
   }
   for (const std::string& name : names_) {

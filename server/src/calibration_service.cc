@@ -32,8 +32,6 @@
 namespace driftlab::server {
 namespace {
 
-std::string Num(double v) { return fmt::format("{:.17g}", v); }
-
 // INVALID_ARGUMENT for a library SpecError: fields of the settings message get "settings.".
 grpc::Status SettingsError(const SpecError& e, const google::protobuf::Descriptor* settings) {
   const std::string& field = e.field();
@@ -106,7 +104,7 @@ grpc::Status ReadStream(grpc::ServerReader<Request>* reader, const ServerLimits&
       for (int i = 0; i < values.size(); ++i) {
         if (!std::isfinite(values[i])) {
           const size_t row = table->values.size() / columns + static_cast<size_t>(i) / columns;
-          throw SpecError(fmt::format("rows[{}].values[{}]", rows_message, i), Num(values[i]),
+          throw SpecError(fmt::format("rows[{}].values[{}]", rows_message, i), ValueText(values[i]),
                           fmt::format("a finite number (row {}, column {})", row,
                                       static_cast<size_t>(i) % columns));
         }
@@ -144,7 +142,7 @@ app::CalibrateSettings ToCalibrateSettings(const v1::CalibrateSettings& in) {
   out.kind = in.kind();
   if (in.has_rate_hz()) {
     if (!std::isfinite(in.rate_hz()) || in.rate_hz() <= 0.0) {
-      throw SpecError("settings.rate_hz", Num(in.rate_hz()),
+      throw SpecError("settings.rate_hz", ValueText(in.rate_hz()),
                       "a finite rate > 0 Hz (or absent when the columns have t_s)");
     }
     out.rate_hz = in.rate_hz();
@@ -165,7 +163,7 @@ app::CalibrateSettings ToCalibrateSettings(const v1::CalibrateSettings& in) {
 app::NoiseFitSettings ToNoiseFitSettings(const v1::NoiseFitSettings& in) {
   app::NoiseFitSettings out;
   if (!std::isfinite(in.rate_hz()) || in.rate_hz() <= 0.0) {
-    throw SpecError("settings.rate_hz", Num(in.rate_hz()), "a finite sample rate > 0 Hz");
+    throw SpecError("settings.rate_hz", ValueText(in.rate_hz()), "a finite sample rate > 0 Hz");
   }
   out.rate_hz = in.rate_hz();
   // settings.columns name the streamed table's columns; the fit selects among them as `allan

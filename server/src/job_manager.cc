@@ -603,9 +603,10 @@ void JobManager::RunJob(const std::shared_ptr<LiveJob>& live) {
       error =
           live->reason == CancelReason::kDeadline ? "deadline exceeded" : "cancelled by its owner";
     } else {
+      // ToJobResult throws for a non-finite statistic (CheckResultStatistics): never stored as a
+      // success.
       const v1::JobResult result =
           app::ToJobResult(app::JobAsRun(request.job(), job.spec), output, version_);
-      app::CheckResultStatistics(result);  // never a non-finite statistic stored as success
       store_->StoreResult(id, SerializeDeterministic(result), UnixNow());
       final_state = v1::SUCCEEDED;
     }

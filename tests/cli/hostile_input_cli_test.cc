@@ -247,7 +247,7 @@ TEST(HostileInput, ReportRefusesMeansItsPerRunValuesDoNotGive) {
   // A structurally valid result whose epoch means were edited to +-1e308: `report` checks the
   // statistics against the per-run values before rendering (result_check.h), refuses with exit 2
   // naming the field, and writes nothing. (The renderer itself with such values:
-  // tests/report/result_report_gate_test.cc, HtmlReport.ExtremeValuesRenderWithoutNonFinite.)
+  // tests/report/result_report_test.cc, HtmlReport.ExtremeValuesRenderWithoutNonFinite.)
   Scratch scratch;
   const std::string text = WithExtremeMeans(ReadFile(kCliData / "gate_baseline.json"), "1e308");
   ASSERT_NE(text.find("\"mean\": -1e308"), std::string::npos);

@@ -20,22 +20,10 @@
 #include <thread>
 #include <vector>
 
-#include "support/cli_runner.h"
+#include "cli_test_util.h"
 
+namespace driftlab::cli_test {
 namespace {
-
-namespace fs = std::filesystem;
-using driftlab::testing::ReadFile;
-using driftlab::testing::Result;
-using driftlab::testing::RunDriftlab;
-using driftlab::testing::Scratch;
-
-const fs::path kData = DRIFTLAB_CLI_TEST_DATA;
-
-fs::path Write(const fs::path& path, const std::string& content) {
-  std::ofstream(path, std::ios::binary) << content;
-  return path;
-}
 
 // A job of 2 runs over 10 s at 20 Hz: quick to run, a valid input for every result tool.
 const char kTinyJob[] = R"({"name": "tiny", "rate_hz": 20,
@@ -137,9 +125,9 @@ TEST(OutputPaths, ResultToolsRefuseToReplaceTheirInputs) {
 TEST(OutputPaths, CalibrationAndDatasheetToolsRefuseToReplaceTheirInputs) {
   Scratch scratch;
   const fs::path csv =
-      Write(scratch.dir() / "gyro.csv", ReadFile(kData / "calib_seed003_gyro.csv"));
+      Write(scratch.dir() / "gyro.csv", ReadFile(kCliData / "calib_seed003_gyro.csv"));
   const fs::path sheet =
-      Write(scratch.dir() / "sheet.yaml", ReadFile(kData / "datasheet_tactical.yaml"));
+      Write(scratch.dir() / "sheet.yaml", ReadFile(kCliData / "datasheet_tactical.yaml"));
   std::string rates = "gyro_x_rad_per_s\n";
   for (int k = 0; k < 64; ++k) rates += std::to_string(0.001 * ((k * 7) % 13) - 0.006) + "\n";
   const fs::path data = Write(scratch.dir() / "rates.csv", rates);
@@ -289,3 +277,4 @@ TEST(OutputSets, AFullDiskLeavesTheOlderSetUntouched) {
 }
 
 }  // namespace
+}  // namespace driftlab::cli_test

@@ -10,17 +10,10 @@
 #include <filesystem>
 #include <string>
 
-#include "support/cli_runner.h"
+#include "cli_test_util.h"
 
+namespace driftlab::cli_test {
 namespace {
-
-namespace fs = std::filesystem;
-using driftlab::testing::ReadFile;
-using driftlab::testing::Result;
-using driftlab::testing::RunDriftlab;
-using driftlab::testing::Scratch;
-
-const fs::path kData = DRIFTLAB_CLI_TEST_DATA;
 
 // The last errors.csv row against run `run` of the result's final checkpoint (python3: exact
 // float parsing of both files).
@@ -47,7 +40,7 @@ int CompareFinalRow(const fs::path& result, const fs::path& errors, int run) {
 
 void ExpectSimulateRunIsRunOfTheMonteCarlo(const std::string& job_file) {
   Scratch scratch;
-  const fs::path job = kData / job_file;
+  const fs::path job = kCliData / job_file;
   const fs::path result = scratch.dir() / "result.json";
   const Result r = RunDriftlab({"run", job.string(), "--out", result.string(), "-q"}, scratch);
   ASSERT_EQ(r.exit_status, 0) << r.err;
@@ -68,7 +61,7 @@ TEST(SimulateRun, EkfWithInitialErrorsAndGnssIsRunNOfTheMonteCarlo) {
   Scratch scratch;
   const fs::path out = scratch.dir() / "out";
   const Result s = RunDriftlab(
-      {"simulate", (kData / "mc_small_gnss.json").string(), "--out", out.string()}, scratch);
+      {"simulate", (kCliData / "mc_small_gnss.json").string(), "--out", out.string()}, scratch);
   ASSERT_EQ(s.exit_status, 0) << s.err;
   EXPECT_NE(ReadFile(out / "filter.csv").find("accel_bias_x_m_per_s2"), std::string::npos);
 }
@@ -82,7 +75,7 @@ TEST(SimulateRun, RunIndexBeyondTheJobsRunsIsRefused) {
   Scratch scratch;
   const fs::path out = scratch.dir() / "out";
   const Result s = RunDriftlab(
-      {"simulate", (kData / "mc_small_gnss.json").string(), "--run", "6", "--out", out.string()},
+      {"simulate", (kCliData / "mc_small_gnss.json").string(), "--run", "6", "--out", out.string()},
       scratch);
   EXPECT_EQ(s.exit_status, 2);
   EXPECT_NE(s.err.find("--run: 6"), std::string::npos) << s.err;
@@ -90,3 +83,4 @@ TEST(SimulateRun, RunIndexBeyondTheJobsRunsIsRefused) {
 }
 
 }  // namespace
+}  // namespace driftlab::cli_test

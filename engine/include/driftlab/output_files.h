@@ -22,6 +22,17 @@ class OutputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// `path` in single quotes for a message, at most about max_bytes bytes of it (MessageText): a
+// longer path keeps its start and its file name (the name's last max_bytes / 2 bytes when the name
+// alone is longer), with " ... " between them, each cut at a UTF-8 character boundary.
+std::string QuotedPath(const std::filesystem::path& path, size_t max_bytes);
+
+// A SpecError value made of `text` with each "{}" replaced by the next of `paths`, quoted and
+// shortened in the middle (QuotedPath) so that the value fits kMaxMessageValueBytes: the paths
+// share what the rest of the text leaves (at least 32 bytes each), and the text after them (an
+// OS reason, say) is not cut off.
+std::string PathsInMessage(std::string_view text, const std::vector<std::filesystem::path>& paths);
+
 // Throws SpecError(field, "'PATH' (a symbolic link)", "a new file or a regular file to replace")
 // when `path` exists and is not a regular file. For checking command-line outputs before the work
 // starts. (A missing directory is an I/O error when the file is written: OutputError.)

@@ -26,8 +26,9 @@ inline constexpr size_t kMaxMessageTextBytes = 1500;
 // max_bytes, the first max_bytes bytes (cut at a character boundary) and " ... (N bytes)".
 std::string MessageText(std::string_view text, size_t max_bytes);
 
-// A number as SpecError messages show it: 17 significant digits (printf %.17g), which parse back
-// to the same double.
+// A number as SpecError messages show it: the shortest text that parses back to the same double
+// (std::to_chars), laid out as fmt's "{}" lays it out: fixed notation for decimal exponents
+// -4 <= e < 16, scientific otherwise ("0.51", "100000", "1e+16", "1.5e-07", "nan", "-inf").
 std::string ValueText(double value);
 
 // "field[i]": the path of element i of a repeated field.

@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <system_error>
@@ -29,7 +30,43 @@ std::filesystem::path DirectoryOf(const std::filesystem::path& path) {
   return path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
 }
 
+bool IsUtf8Continuation(char c) { return (static_cast<unsigned char>(c) & 0xC0) == 0x80; }
+
 }  // namespace
+
+std::string QuotedPath(const std::filesystem::path& path, size_t max_bytes) {
+  const std::string text = path.string();
+  if (text.size() <= max_bytes) return "'" + MessageText(text, max_bytes) + "'";
+  constexpr std::string_view kGap = " ... ";
+  const std::string name = path.filename().string();
+  size_t name_start = name.size() > max_bytes / 2 ? name.size() - max_bytes / 2 : 0;
+  while (name_start < name.size() && IsUtf8Continuation(name[name_start])) ++name_start;
+  const std::string name_end = name.substr(name_start);
+  size_t head =
+      max_bytes > name_end.size() + kGap.size() ? max_bytes - name_end.size() - kGap.size() : 0;
+  while (head > 0 && IsUtf8Continuation(text[head])) --head;
+  return "'" + MessageText(text.substr(0, head), head) + std::string(kGap) +
+         MessageText(name_end, name_end.size()) + "'";
+}
+
+std::string PathsInMessage(std::string_view text, const std::vector<std::filesystem::path>& paths) {
+  constexpr std::string_view kSlot = "{}";
+  // Each "{}" becomes a path's two quotes: the text's other bytes are its size.
+  const size_t other_bytes = text.size();
+  const size_t left = kMaxMessageValueBytes > other_bytes ? kMaxMessageValueBytes - other_bytes : 0;
+  const size_t each = std::max<size_t>(32, paths.empty() ? 0 : left / paths.size());
+  std::string out;
+  size_t from = 0;
+  for (const std::filesystem::path& path : paths) {
+    const size_t slot = text.find(kSlot, from);
+    if (slot == std::string_view::npos) break;
+    out.append(text.substr(from, slot - from));
+    out += QuotedPath(path, each);
+    from = slot + kSlot.size();
+  }
+  out.append(text.substr(from));
+  return out;
+}
 
 void CheckOutputPath(const std::filesystem::path& path, const std::string& field) {
   if (path.empty() || !path.has_filename()) {
@@ -38,12 +75,12 @@ void CheckOutputPath(const std::filesystem::path& path, const std::string& field
   struct stat st {};
   if (::lstat(path.c_str(), &st) == 0) {
     if (!S_ISREG(st.st_mode)) {
-      throw SpecError(field, "'" + path.string() + "' (" + KindOf(st.st_mode) + ")",
+      throw SpecError(field, PathsInMessage("{} (" + KindOf(st.st_mode) + ")", {path}),
                       "a new file or a regular file to replace (driftlab never writes over "
                       "anything else)");
     }
   } else if (errno != ENOENT) {
-    throw SpecError(field, "'" + path.string() + "' (" + std::strerror(errno) + ")",
+    throw SpecError(field, PathsInMessage(std::string("{} (") + std::strerror(errno) + ")", {path}),
                     "a writable path");
   }
 }
@@ -87,10 +124,6 @@ FileIdentity IdentityOf(const std::filesystem::path& path) {
   return id;
 }
 
-std::string Quoted(const std::filesystem::path& path) {
-  return "'" + MessageText(path.string(), kMaxMessageValueBytes) + "'";
-}
-
 }  // namespace
 
 void CheckOutputsApart(const std::vector<CommandPath>& inputs,
@@ -105,18 +138,20 @@ void CheckOutputsApart(const std::vector<CommandPath>& inputs,
         "and inode)";
     for (size_t i = 0; i < inputs.size(); ++i) {
       if (input_ids[i].exists && id == input_ids[i]) {
-        throw SpecError(output.option,
-                        Quoted(output.path) + " (the same file as " + inputs[i].option + " " +
-                            Quoted(inputs[i].path) + ", an input)",
-                        allowed);
+        throw SpecError(
+            output.option,
+            PathsInMessage("{} (the same file as " + inputs[i].option + " {}, an input)",
+                           {output.path, inputs[i].path}),
+            allowed);
       }
     }
     for (size_t j = 0; j < output_ids.size(); ++j) {
       if (id == output_ids[j]) {
-        throw SpecError(output.option,
-                        Quoted(output.path) + " (the same file as " + outputs[j].option + " " +
-                            Quoted(outputs[j].path) + ", another output)",
-                        allowed);
+        throw SpecError(
+            output.option,
+            PathsInMessage("{} (the same file as " + outputs[j].option + " {}, another output)",
+                           {output.path, outputs[j].path}),
+            allowed);
       }
     }
     output_ids.push_back(id);
@@ -149,7 +184,7 @@ void CheckOutputWritable(const std::filesystem::path& path, const std::string& f
     reason = std::strerror(errno);
   }
   throw SpecError(field,
-                  Quoted(path) + " (cannot create a file in " + Quoted(dir) + ": " + reason + ")",
+                  PathsInMessage("{} (cannot create a file in {}: " + reason + ")", {path, dir}),
                   "a path in a directory where files can be created");
 }
 
@@ -188,8 +223,8 @@ void OutputFile::Fail(const std::string& what, int error_number) {
   if (!temporary_.empty()) ::unlink(temporary_.c_str());
   temporary_.clear();
   throw OutputError(
-      MessageText(field_, kMaxMessageFieldBytes) + ": cannot write '" +
-      MessageText(path_.string(), kMaxMessageValueBytes) + "': " + what +
+      MessageText(field_, kMaxMessageFieldBytes) + ": cannot write " +
+      QuotedPath(path_, kMaxMessageValueBytes) + ": " + what +
       (error_number != 0 ? std::string(" (") + std::strerror(error_number) + ")" : std::string()));
 }
 

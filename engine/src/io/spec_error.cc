@@ -2,8 +2,9 @@
 #include "driftlab/spec_error.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cstdint>
-#include <cstdio>
+#include <cstdlib>
 
 namespace driftlab {
 namespace {
@@ -73,8 +74,28 @@ std::string MessageText(std::string_view text, size_t max_bytes) {
 
 std::string ValueText(double value) {
   char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.17g", value);
-  return buffer;
+  char* end =
+      std::to_chars(buffer, buffer + sizeof(buffer), value, std::chars_format::scientific).ptr;
+  const std::string text(buffer, end);  // [-]d[.ddd]e(+|-)XX, or nan, inf
+  const size_t e = text.find('e');
+  if (e == std::string::npos) return text;
+  const int exponent = std::atoi(text.c_str() + e + 1);
+  if (exponent < -4 || exponent >= 16) return text;
+  const size_t sign = text[0] == '-' ? 1 : 0;
+  std::string digits;  // the significant digits without the point
+  for (size_t i = sign; i < e; ++i) {
+    if (text[i] != '.') digits += text[i];
+  }
+  std::string out = text.substr(0, sign);
+  if (exponent < 0) {
+    out += "0." + std::string(static_cast<size_t>(-exponent - 1), '0') + digits;
+  } else if (static_cast<size_t>(exponent) + 1 >= digits.size()) {
+    out += digits + std::string(static_cast<size_t>(exponent) + 1 - digits.size(), '0');
+  } else {
+    out += digits.substr(0, static_cast<size_t>(exponent) + 1) + "." +
+           digits.substr(static_cast<size_t>(exponent) + 1);
+  }
+  return out;
 }
 
 std::string IndexedField(const std::string& field, size_t i) {

@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <numbers>
 
 #include "driftlab/elementary.h"
@@ -19,29 +18,23 @@
 namespace driftlab {
 namespace {
 
-std::string FormatValue(double v) {
-  char buffer[40];
-  std::snprintf(buffer, sizeof(buffer), "%.17g", v);
-  return buffer;
-}
-
 void RequireFinite(double v, const std::string& field) {
-  if (!std::isfinite(v)) throw SpecError(field, FormatValue(v), "a finite number");
+  if (!std::isfinite(v)) throw SpecError(field, ValueText(v), "a finite number");
 }
 
 void RequireNonNegative(double v, const std::string& field) {
-  if (!std::isfinite(v) || v < 0.0) throw SpecError(field, FormatValue(v), "finite value >= 0");
+  if (!std::isfinite(v) || v < 0.0) throw SpecError(field, ValueText(v), "finite value >= 0");
 }
 
 void RequirePositive(double v, const std::string& field, const std::string& why) {
   if (!std::isfinite(v) || v <= 0.0) {
-    throw SpecError(field, FormatValue(v), "finite value > 0" + why);
+    throw SpecError(field, ValueText(v), "finite value > 0" + why);
   }
 }
 
 void RequireOpenUnit(double v, const std::string& field) {
   if (!std::isfinite(v) || v <= -1.0 || v >= 1.0) {
-    throw SpecError(field, FormatValue(v), "-1 < value < 1 (dimensionless, e.g. 100 ppm = 1e-4)");
+    throw SpecError(field, ValueText(v), "-1 < value < 1 (dimensionless, e.g. 100 ppm = 1e-4)");
   }
 }
 
@@ -109,8 +102,8 @@ void ValidateTriadErrorParams(const TriadErrorParams& p, const std::string& path
                     " when bias_flicker.bias_instability > 0");
     if (!(f.tau_max_s > f.tau_min_s) || f.tau_max_s > kMaxFlickerRangeRatio * f.tau_min_s) {
       throw SpecError(
-          path + ".bias_flicker.tau_max_s", FormatValue(f.tau_max_s),
-          "tau_min_s < tau_max_s <= 1e9 tau_min_s (tau_min_s = " + FormatValue(f.tau_min_s) + ")");
+          path + ".bias_flicker.tau_max_s", ValueText(f.tau_max_s),
+          "tau_min_s < tau_max_s <= 1e9 tau_min_s (tau_min_s = " + ValueText(f.tau_min_s) + ")");
     }
   }
 
@@ -122,7 +115,7 @@ void ValidateTriadErrorParams(const TriadErrorParams& p, const std::string& path
   }
   RequireNonNegative(p.scale_factor_sigma, path + ".scale_factor_sigma");
   if (p.scale_factor_sigma > 0.1 * (1.0 + 1e-12)) {  // 1e5 ppm, whatever its rounding
-    throw SpecError(path + ".scale_factor_sigma", FormatValue(p.scale_factor_sigma),
+    throw SpecError(path + ".scale_factor_sigma", ValueText(p.scale_factor_sigma),
                     "0 <= value <= 0.1 (10 %; dimensionless)");
   }
   for (int r = 0; r < 3; ++r) {
@@ -131,17 +124,17 @@ void ValidateTriadErrorParams(const TriadErrorParams& p, const std::string& path
       const double m = p.misalignment_fixed(r, c);
       if (r == c) {
         if (m != 0.0) {
-          throw SpecError(field, FormatValue(m),
+          throw SpecError(field, ValueText(m),
                           "0 (diagonal: use scale_factor_fixed for scale-factor errors)");
         }
       } else if (!std::isfinite(m) || std::fabs(m) >= 0.5) {
-        throw SpecError(field, FormatValue(m), "|value| < 0.5 rad (small misalignment)");
+        throw SpecError(field, ValueText(m), "|value| < 0.5 rad (small misalignment)");
       }
     }
   }
   RequireNonNegative(p.misalignment_sigma_rad, path + ".misalignment_sigma_rad");
   if (p.misalignment_sigma_rad > 0.1 * (1.0 + 1e-12)) {  // 100 mrad, whatever its rounding
-    throw SpecError(path + ".misalignment_sigma_rad", FormatValue(p.misalignment_sigma_rad),
+    throw SpecError(path + ".misalignment_sigma_rad", ValueText(p.misalignment_sigma_rad),
                     "0 <= value <= 0.1 rad");
   }
   RequireNonNegative(p.quantization, path + ".quantization");
@@ -201,7 +194,7 @@ TriadJobConstants ComposeTriadJobConstants(const TriadErrorParams& params, doubl
                                            const std::string& path) {
   ValidateTriadErrorParams(params, path);
   if (!std::isfinite(rate_hz) || rate_hz <= 0.0) {
-    throw SpecError("rate_hz", FormatValue(rate_hz), "finite value > 0 [Hz]");
+    throw SpecError("rate_hz", ValueText(rate_hz), "finite value > 0 [Hz]");
   }
   TriadJobConstants job;
   job.dt_s = 1.0 / rate_hz;

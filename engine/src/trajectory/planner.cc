@@ -171,14 +171,41 @@ void Planner::AddTurn(double omega, double transition_s, double hold_s) {
   if (Tr > 0.0) Add(Tr, piece(state_.chi, omega, -omega / (2.0 * Tr)));
 }
 
-void Planner::CheckImpliedTurnRate(const std::string& field, double radius_m, double V) const {
-  const double omega = V / radius_m;
-  if (!(omega <= kMaxTurnRate_rad_per_s)) {
-    Reject(field, radius_m,
-           "radius_m >= " + CompactText(V / kMaxTurnRate_rad_per_s) + " m at the ground speed " +
-               CompactText(V) + " m/s (a turn rate of at most " +
-               CompactText(kMaxTurnRate_rad_per_s * kRadToDeg) + " deg/s, as for rate_deg_per_s)");
+double Planner::TurnRate(const std::string& base, const TurnRateSpec& turn, double V) const {
+  double omega;
+  if (turn.rate_rad_per_s) {
+    omega = *turn.rate_rad_per_s;
+    if (turn.either_sign) {
+      if (!(std::isfinite(omega) && omega != 0.0 && std::abs(omega) <= kMaxTurnRate_rad_per_s)) {
+        Reject(base + ".rate_deg_per_s", omega * kRadToDeg,
+               "-720 <= rate_deg_per_s <= 720 deg/s, not 0");
+      }
+    } else if (!(omega > 0.0 && omega <= kMaxTurnRate_rad_per_s)) {
+      Reject(base + ".rate_deg_per_s", omega * kRadToDeg, "0 < rate_deg_per_s <= 720 deg/s");
+    }
+  } else {
+    const double radius_m = *turn.radius_m;
+    CheckPositive(base + ".radius_m", radius_m, 1.0e7, " m");
+    if (!(V > 0.0)) {
+      RejectText(base + ".radius_m",
+                 std::string("given at ground speed 0; allowed: ") + turn.radius_at_rest_allowed);
+    }
+    omega = (turn.right ? 1.0 : -1.0) * V / radius_m;
+    if (!(V / radius_m <= kMaxTurnRate_rad_per_s)) {
+      Reject(base + ".radius_m", radius_m,
+             "radius_m >= " + CompactText(V / kMaxTurnRate_rad_per_s) + " m at the ground speed " +
+                 CompactText(V) + " m/s (a turn rate of at most " +
+                 CompactText(kMaxTurnRate_rad_per_s * kRadToDeg) +
+                 " deg/s, as for rate_deg_per_s)");
+    }
   }
+  const double Tr = turn.transition_s;
+  CheckNonNegative(base + ".transition_s", Tr, kMaxDuration_s / 2.0, " s");
+  if (motion_.vehicle.coordinated_turns && Tr == 0.0) {
+    Reject(base + ".transition_s", Tr,
+           "transition_s > 0 with vehicle.coordinated_turns (the bank angle must be continuous)");
+  }
+  return omega;
 }
 
 void Planner::PlanSegment(const TurnSegment& s, const std::string& path) {
@@ -193,29 +220,12 @@ void Planner::PlanSegment(const TurnSegment& s, const std::string& path) {
   }
   double V, chi, vD;
   TrackStart(&V, &chi, &vD);
-  double omega;
-  if (s.rate_rad_per_s) {
-    omega = *s.rate_rad_per_s;
-    if (!(std::isfinite(omega) && omega != 0.0 && std::abs(omega) <= kMaxTurnRate_rad_per_s)) {
-      Reject(base + ".rate_deg_per_s", omega * kRadToDeg,
-             "-720 <= rate_deg_per_s <= 720 deg/s, not 0");
-    }
-  } else {
-    CheckPositive(base + ".radius_m", *s.radius_m, 1.0e7, " m");
-    if (!(V > 0.0)) {
-      RejectText(base + ".radius_m",
-                 "given at ground speed 0; allowed: a turn by radius needs "
-                 "speed > 0 (give rate_deg_per_s to turn on the spot)");
-    }
-    omega = (s.right ? 1.0 : -1.0) * V / *s.radius_m;
-    CheckImpliedTurnRate(base + ".radius_m", *s.radius_m, V);
-  }
+  const double omega =
+      TurnRate(base,
+               {s.rate_rad_per_s, s.radius_m, s.right, /*either_sign=*/true, s.transition_s,
+                "a turn by radius needs speed > 0 (give rate_deg_per_s to turn on the spot)"},
+               V);
   const double Tr = s.transition_s;
-  CheckNonNegative(base + ".transition_s", Tr, kMaxDuration_s / 2.0, " s");
-  if (motion_.vehicle.coordinated_turns && Tr == 0.0) {
-    Reject(base + ".transition_s", Tr,
-           "transition_s > 0 with vehicle.coordinated_turns (the bank angle must be continuous)");
-  }
   double hold;
   if (s.angle_rad) {
     const double angle = *s.angle_rad;
@@ -440,27 +450,11 @@ void Planner::PlanSegment(const FigureEightSegment& s, const std::string& path) 
   }
   double V, chi, vD;
   TrackStart(&V, &chi, &vD);
-  double omega;
-  if (s.rate_rad_per_s) {
-    if (!(*s.rate_rad_per_s > 0.0 && *s.rate_rad_per_s <= kMaxTurnRate_rad_per_s)) {
-      Reject(base + ".rate_deg_per_s", *s.rate_rad_per_s * kRadToDeg,
-             "0 < rate_deg_per_s <= 720 deg/s");
-    }
-    omega = *s.rate_rad_per_s;
-  } else {
-    CheckPositive(base + ".radius_m", *s.radius_m, 1.0e7, " m");
-    if (!(V > 0.0)) {
-      RejectText(base + ".radius_m", "given at ground speed 0; allowed: speed > 0");
-    }
-    omega = V / *s.radius_m;
-    CheckImpliedTurnRate(base + ".radius_m", *s.radius_m, V);
-  }
+  const double omega = TurnRate(base,
+                                {s.rate_rad_per_s, s.radius_m, /*right=*/true,
+                                 /*either_sign=*/false, s.transition_s, "speed > 0"},
+                                V);
   const double Tr = s.transition_s;
-  CheckNonNegative(base + ".transition_s", Tr, kMaxDuration_s / 2.0, " s");
-  if (motion_.vehicle.coordinated_turns && Tr == 0.0) {
-    Reject(base + ".transition_s", Tr,
-           "transition_s > 0 with vehicle.coordinated_turns (the bank angle must be continuous)");
-  }
   const double hold = 2.0 * M_PI / omega - Tr;
   if (hold < 0.0) {
     Reject(base + ".transition_s", Tr,

@@ -67,8 +67,21 @@ class Planner {
   void AddTurn(double omega, double transition_s, double hold_s);
   // Turns and figure eights: at most 720 deg/s, given as a rate or implied by radius and speed.
   static constexpr double kMaxTurnRate_rad_per_s = 4.0 * M_PI;
-  // A radius at ground speed V [m/s] whose turn rate V / radius exceeds kMaxTurnRate_rad_per_s.
-  void CheckImpliedTurnRate(const std::string& field, double radius_m, double V) const;
+  // A turn's rate as a turn or a figure-eight segment gives it: exactly one of rate_rad_per_s and
+  // radius_m (the caller checks that), and the ramp time transition_s.
+  struct TurnRateSpec {
+    std::optional<double> rate_rad_per_s;
+    std::optional<double> radius_m;
+    bool right = true;        // a radius turns right (omega > 0) or left
+    bool either_sign = true;  // a rate may be negative (a turn) or must be positive (figure eight)
+    double transition_s = 0.0;
+    const char* radius_at_rest_allowed = "";  // what a radius at ground speed 0 is told is allowed
+  };
+  // The turn rate omega [rad/s] of `turn` at ground speed V [m/s]: the rate, or +-V / radius_m. The
+  // rate, given or implied, is at most kMaxTurnRate_rad_per_s; transition_s is checked too (>= 0,
+  // and > 0 with vehicle.coordinated_turns). Messages name base + ".rate_deg_per_s", ".radius_m",
+  // ".transition_s".
+  double TurnRate(const std::string& base, const TurnRateSpec& turn, double V) const;
   void PlanSegment(const TurnSegment& s, const std::string& path);
   void PlanSegment(const ClimbSegment& s, const std::string& path);
   void PlanSegment(const ZigzagSegment& s, const std::string& path);

@@ -67,6 +67,24 @@ TEST(ValidationPath, EpochLimitIsCheckedWithoutRunning) {
       "");
 }
 
+// The refusal names the shortest interval as a user writes it: 10 000 s at 100 Hz in at most
+// 20 000 epochs needs 1 000 000 / 19 999 + 1 = 51 samples between epochs, 0.51 s (51 x 0.01 s,
+// which 17 significant digits print as 0.51000000000000001).
+TEST(ValidationPath, EpochLimitMessageSaysTheShortestIntervalAsWritten) {
+  ASSERT_EQ(kMaxMonteCarloEpochs, size_t{20000});
+  std::string message;
+  try {
+    ToMonteCarloSpec(
+        File(JobWithMonteCarloAt(R"({"runs": 1, "epoch_interval_s": 0.01})", 100.0, 10000.0)), {});
+  } catch (const SpecError& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find("monte_carlo.epoch_interval_s: 0.01 s is not allowed; allowed: at least "
+                         "0.51 s, a multiple of 1 / rate_hz"),
+            std::string::npos)
+      << message;
+}
+
 TEST(ValidationPath, JobOverItsMemoryLimitIsRefusedBeforeAnyAllocation) {
   // 1 run x 100 000 s at 2000 Hz = 2e8 IMU increments of shared truth, each two
   // 3-vectors of doubles (48 bytes): at least 9.6 GB, over the 8 GB default.

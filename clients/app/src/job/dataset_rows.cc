@@ -18,8 +18,6 @@ namespace {
 
 enum NavigationColumn { kT = 0, kLat, kLon, kHeight, kVn, kVe, kVd, kRoll, kPitch, kYaw };
 
-std::string Num(double v) { return fmt::format("{:.17g}", v); }
-
 }  // namespace
 
 const std::vector<std::string>& ImuColumns() {
@@ -126,11 +124,12 @@ SolutionState SolutionColumns::Parse(const double* row, uint64_t row_index,
     v[c] = row[index_[c]];
     if (!std::isfinite(v[c])) {
       throw SpecError(fmt::format("{}[{}].{}", field, row_index, known[static_cast<size_t>(c)]),
-                      Num(v[c]), "a finite number");
+                      ValueText(v[c]), "a finite number");
     }
   }
   if (std::abs(v[kLat]) > 90.0) {
-    throw SpecError(fmt::format("{}[{}].lat_deg", field, row_index), Num(v[kLat]), "[-90, 90] deg");
+    throw SpecError(fmt::format("{}[{}].lat_deg", field, row_index), ValueText(v[kLat]),
+                    "[-90, 90] deg");
   }
   SolutionState s;
   s.t_s = v[kT];
@@ -183,8 +182,8 @@ void RunScorer::Add(const SolutionState& state, uint64_t row_index, const std::s
   if (it == reports_.end() || it->t_s > state.t_s + tolerance) return;
   if (it->error) {
     throw SpecError(
-        fmt::format("{}[{}].t_s", field, row_index), Num(state.t_s),
-        fmt::format("one row per epoch (a row at t_s = {} s came before)", Num(it->t_s)));
+        fmt::format("{}[{}].t_s", field, row_index), ValueText(state.t_s),
+        fmt::format("one row per epoch (a row at t_s = {} s came before)", ValueText(it->t_s)));
   }
   it->error = SolutionError(env_, state, it->truth);
 }
@@ -197,10 +196,10 @@ MonteCarloStatistics RunScorer::Statistics(const std::string& field) const {
   data.runs.push_back(RunRange{run_, run_ + 1});
   for (const Report& r : reports_) {
     if (!r.error) {
-      throw SpecError(field, fmt::format("no row at t_s = {} s", Num(r.t_s)),
+      throw SpecError(field, fmt::format("no row at t_s = {} s", ValueText(r.t_s)),
                       fmt::format("a row at every output epoch of the job ({} epochs and "
                                   "checkpoints, matched within {} s)",
-                                  reports_.size(), Num(kTimeMatchFraction * dt_s_)));
+                                  reports_.size(), ValueText(kTimeMatchFraction * dt_s_)));
     }
     const ErrorComponentValues v = ErrorComponentsOf(*r.error);
     if (r.epoch >= 0) {
