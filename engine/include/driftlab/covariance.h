@@ -23,10 +23,13 @@ namespace driftlab {
 //   B = F_ns dt + (F_nn F_ns + F_ns D) dt^2 / 2 (the second-order terms of (F dt)^2 / 2),
 //   d = 1 + D dt + (D dt)^2 / 2,
 // the same Phi and trapezoidal Q_d as the dense second-order formula, in O(9 m^2) instead of
-// O((9 + m)^3) operations. With kVanLoan (exact Phi = exp(F dt) and Q_d) the same structure gives
-// the exact step from the power series of the blocks (covariance.cc), O(K^2 9 m) for K terms
-// (~10 at 0.1 s), instead of the exponential of a 2(9 + m)-square matrix; steps too long for the
-// series (||F_nn dt||_1 > 2 or |D dt| > 2) use that exponential.
+// O((9 + m)^3) operations. With kVanLoan (exact Phi = exp(F dt) and Q_d) the same structure and
+// the sensor columns of F_ns (ErrorStateSensorCoupling: each a column of C_b_n times a weight)
+// give the exact step from power series in F_nn dt and scalar series in D dt (covariance.cc),
+// O(J^2 m) for J powers of F_nn dt (~7 at 0.1 s), plus O(9 m^2) for Phi P Phi^T (O(9 m)
+// while P_ss is diagonal, as in a free-inertial analysis), instead of the exponential of a
+// 2(9 + m)-square matrix; steps too long for the series (||F_nn dt||_1 > 2 or |D dt| > 2) use
+// that exponential.
 class ErrorCovariancePropagator {
  public:
   ErrorCovariancePropagator(const NavEnvironment& env, const ErrorStateNoise& noise,
@@ -52,35 +55,46 @@ class ErrorCovariancePropagator {
   std::vector<ErrorStateMatrix>& mutable_source_P() { return source_P_; }
 
  private:
+  // The discretisation of the step just taken (its terms are kept for the sources' steps).
+  enum class Step { kSecondOrder, kSeries, kDense };
   NavEnvironment env_;
   ErrorStateNoise noise_;
   ErrorStateLayout layout_;
   ErrorStateMatrix Q_c_;
   Discretization method_;
   ErrorStateMatrix P_;
-  // The exact structured step; false when F lacks the structure or dt is too long for the series.
-  bool PropagateExactSeries(const ErrorStateMatrix& F, double dt_s);
+  Step step_ = Step::kSecondOrder;
+  // The exact structured step; false when dt is too long for the series.
+  bool PropagateExactSeries(const ErrorStateMatrix& F, const Matrix3d& C_b_n, double h);
   // P <- Phi P Phi^T + Q_d from Phi = [[A_, B_], [0, diag(d_)]] and the blocks of Q_d.
   void ApplyStructuredStep(const Eigen::MatrixXd& Qd_nn, const Eigen::MatrixXd& Qd_ns,
                            const Eigen::VectorXd& Qd_ss, ErrorStateMatrix* P);
-  // The sources' steps with the Phi of the step just taken (A_, B_, d_; Phi_ for the dense one).
-  void PropagateSourcesSecondOrder(double dt_s);
-  void PropagateSourcesSeries(double h);
+  // The blocks of Q_d of the step just taken (step_) for the continuous white-noise PSDs q (the
+  // diagonal of a Q_c, or a source's share of it), nonzero only at the indices `support`.
+  void ProcessNoise(const Eigen::VectorXd& q, const std::vector<int>& support, double dt_s,
+                    Eigen::MatrixXd* Qd_nn, Eigen::MatrixXd* Qd_ns, Eigen::VectorXd* Qd_ss);
+  // The sources' steps with the transition of the step just taken.
+  void PropagateSources(double dt_s);
   void PropagateSourcesDense(const ErrorStateMatrix& F, double dt_s);
   // Work space of the structured step (allocated once).
-  Eigen::MatrixXd A_, B_, BPss_, Pnn_, Pns_;
-  Eigen::VectorXd d_, q_s_;
+  Eigen::MatrixXd A_, B_, BPss_, Pnn_, Pns_, APnsBt_, Qd_nn_, Qd_ns_;
+  Eigen::VectorXd d_, q_s_, q_c_, Qd_ss_;
+  std::vector<int> q_support_;  // indices where diag(Q_c) > 0
+  std::vector<SensorStateCoupling> coupling_;
   // The budget's sources: covariance, share of diag(Q_c), and the indices where the share is > 0.
   std::vector<ErrorStateMatrix> source_P_;
   std::vector<Eigen::VectorXd> source_q_;
   std::vector<std::vector<int>> source_support_;
-  // The series terms of the last exact step (PropagateExactSeries), kept for the sources:
-  // N_k, U_k, and the weighted sums sum_j T_j / (i + j + 1) (N_sum, U_sum, G).
-  std::vector<Eigen::Matrix<double, kNumNavErrorStates, kNumNavErrorStates>> series_N_,
-      series_Nsum_;
-  std::vector<Eigen::MatrixXd> series_U_, series_Usum_;
-  std::vector<Eigen::VectorXd> series_G_;
-  Eigen::VectorXd series_Dh_;  // D h
+  // Terms of the last exact step (PropagateExactSeries), J powers of F_nn h: N_k = (F_nn h)^k /
+  // k!, G_k = (F_nn h)^k G h with G the 9 x 6 map of the sensor channels (C_b_n into the velocity
+  // and attitude rows); and the scalar functions of x = D h per sensor state c (columns):
+  // phi_(k+1)(x) of Phi_ns, rho_k(x) and beta_ij(x) (row i * J + j) of Q_d, exp(x), and
+  // expm1(2 x) / (2 x). The scalar functions depend on D h and J only: kept while they repeat.
+  int series_terms_ = 0;
+  std::vector<Eigen::Matrix<double, kNumNavErrorStates, kNumNavErrorStates>> series_N_;
+  std::vector<Eigen::Matrix<double, kNumNavErrorStates, 6>> series_G_;
+  Eigen::MatrixXd series_phi_, series_rho_, series_beta_;
+  Eigen::VectorXd series_Dh_, series_exp_, series_ss_;
 };
 
 // Predicted 1-sigma errors at one epoch, in the components the Monte-Carlo statistics report.

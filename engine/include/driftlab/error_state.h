@@ -199,6 +199,22 @@ ErrorStateMatrix ErrorStateSystemMatrix(const NavEnvironment& env, const NavStat
                                         const Vector3d& f_ib_b, const ErrorStateNoise& noise,
                                         const Vector3d& omega_ib_b = Vector3d::Zero());
 
+// How one sensor error state (index j >= kNumNavErrorStates) enters the navigation error rates:
+// column j of F is F(nav_rows + r, j) = C_b_n(r, axis) * weight, r = 0..2 (the bias, scale-factor
+// and misalignment columns of ErrorStateSystemMatrix: an accelerometer error drives the velocity
+// rows, a gyro error the attitude rows, through one column of C_b_n); `coupled` false: column j
+// of F_ns is zero (the aiding sensors' states). Entry j - kNumNavErrorStates of the result.
+struct SensorStateCoupling {
+  bool coupled = false;
+  int nav_rows = kErrVelocity;  // kErrVelocity or kErrAttitude
+  int axis = 0;                 // body axis: the column of C_b_n
+  double weight = 0.0;          // 1 for a bias; the measured rate / specific force component
+};
+// The couplings of every sensor error state of a layout with the specific force f_ib_b
+// [m/s^2] and the body rate omega_ib_b [rad/s] (the scale-factor and misalignment weights).
+void ErrorStateSensorCoupling(const ErrorStateLayout& layout, const Vector3d& f_ib_b,
+                              const Vector3d& omega_ib_b, std::vector<SensorStateCoupling>* out);
+
 // Continuous process-noise spectral density Q_c = G Q G^T (diagonal).
 ErrorStateMatrix ErrorStateProcessNoise(const ErrorStateNoise& noise);
 

@@ -248,7 +248,6 @@ ErrorStateMatrix ErrorStateSystemMatrix(const NavEnvironment& env, const NavStat
   F.block<3, 3>(kErrAttitude, kErrAttitude) = -Skew(omega_ie_n + omega_en_n);
   F.block<3, 3>(kErrAttitude, kErrVelocity) = -Wen_v;
   F.block<3, 3>(kErrAttitude, kErrPosition) = -(Wie_r + Wen_r);
-  F.block<3, 3>(kErrAttitude, kErrGyroBias) = C_b_n;
   // Velocity.
   const Matrix3d V = Skew(v);
   F.block<3, 3>(kErrVelocity, kErrAttitude) = -Skew(C_b_n * f_ib_b);
@@ -257,7 +256,6 @@ ErrorStateMatrix ErrorStateSystemMatrix(const NavEnvironment& env, const NavStat
   // Vertical gravity gradient, central difference (g_D is quadratic in h: exact to rounding).
   const double dgD_dh = 0.5 * (env.Gravity(L, h + 1.0).z() - env.Gravity(L, h - 1.0).z());
   F(kErrVelocity + 2, kErrPosition + 2) += -dgD_dh;  // dh = -dr_D
-  F.block<3, 3>(kErrVelocity, kErrAccelBias) = C_b_n;
   // Position (metres at the true point).
   F.block<3, 3>(kErrPosition, kErrVelocity) = Matrix3d::Identity();
   if (curved) {
@@ -267,30 +265,25 @@ ErrorStateMatrix ErrorStateSystemMatrix(const NavEnvironment& env, const NavStat
     F(1, 1) += -v.z() / RE - v.x() * tanL / RN;
     F(1, 2) += v.y() / RE;
   }
-  // Biases: b' = -b / tau (Gauss-Markov) or 0.
-  auto bias_block = [&](int first, int nav_rows, const BiasStateModel& b) {
-    F.block<3, 3>(nav_rows, first) = C_b_n;
+  // Sensor errors into the navigation rows (ErrorStateSensorCoupling); biases: b' = -b / tau
+  // (Gauss-Markov) or 0.
+  std::vector<SensorStateCoupling> coupling;
+  ErrorStateSensorCoupling(layout, f_ib_b, omega_ib_b, &coupling);
+  for (int j = kNumNavErrorStates; j < layout.size; ++j) {
+    const SensorStateCoupling& c = coupling[static_cast<size_t>(j - kNumNavErrorStates)];
+    if (c.coupled) F.block<3, 1>(c.nav_rows, j) = C_b_n.col(c.axis) * c.weight;
+  }
+  auto bias_decay = [&](int first, const BiasStateModel& b) {
     if (b.tau_s > 0.0) F.block<3, 3>(first, first) = -Matrix3d::Identity() / b.tau_s;
   };
-  bias_block(kErrAccelBias, kErrVelocity, noise.accel_bias);
-  bias_block(kErrGyroBias, kErrAttitude, noise.gyro_bias);
+  bias_decay(kErrAccelBias, noise.accel_bias);
+  bias_decay(kErrGyroBias, noise.gyro_bias);
   for (size_t i = 0; i < layout.accel_bias_extra.size(); ++i) {
-    bias_block(layout.accel_bias_extra[i], kErrVelocity, noise.accel_bias_extra[i]);
+    bias_decay(layout.accel_bias_extra[i], noise.accel_bias_extra[i]);
   }
   for (size_t i = 0; i < layout.gyro_bias_extra.size(); ++i) {
-    bias_block(layout.gyro_bias_extra[i], kErrAttitude, noise.gyro_bias_extra[i]);
+    bias_decay(layout.gyro_bias_extra[i], noise.gyro_bias_extra[i]);
   }
-  // Scale factor / misalignment (random constants): d(error of m) / d s_i = m_i e_i,
-  // d / d M_ij = m_j e_i, resolved in n by C_b_n (Groves 2nd ed. (4.17), (14.98)).
-  auto sm_block = [&](int scale, int mis, int nav_rows, const Vector3d& m_b) {
-    if (scale < 0) return;
-    for (int i = 0; i < 3; ++i) F.block<3, 1>(nav_rows, scale + i) = C_b_n.col(i) * m_b[i];
-    for (int k = 0; k < 6; ++k) {
-      F.block<3, 1>(nav_rows, mis + k) = C_b_n.col(kMisalignmentRow[k]) * m_b[kMisalignmentCol[k]];
-    }
-  };
-  sm_block(layout.gyro_scale, layout.gyro_misalignment, kErrAttitude, omega_ib_b);
-  sm_block(layout.accel_scale, layout.accel_misalignment, kErrVelocity, f_ib_b);
   // Aiding errors: e' = -e / tau (Gauss-Markov) or 0 (random constants).
   for (size_t b = 0; b < noise.aiding_states.size(); ++b) {
     const AidingErrorStates& a = noise.aiding_states[b];
@@ -301,6 +294,33 @@ ErrorStateMatrix ErrorStateSystemMatrix(const NavEnvironment& env, const NavStat
     }
   }
   return F;
+}
+
+void ErrorStateSensorCoupling(const ErrorStateLayout& layout, const Vector3d& f_ib_b,
+                              const Vector3d& omega_ib_b, std::vector<SensorStateCoupling>* out) {
+  out->assign(static_cast<size_t>(layout.size - kNumNavErrorStates), SensorStateCoupling{});
+  auto set = [out](int state, int nav_rows, int axis, double weight) {
+    (*out)[static_cast<size_t>(state - kNumNavErrorStates)] = {true, nav_rows, axis, weight};
+  };
+  // Biases: the bias of body axis i adds C_b_n.col(i) to the velocity (accelerometer) or attitude
+  // (gyro) error rate.
+  auto bias = [&](int first, int nav_rows) {
+    for (int i = 0; i < 3; ++i) set(first + i, nav_rows, i, 1.0);
+  };
+  bias(kErrAccelBias, kErrVelocity);
+  bias(kErrGyroBias, kErrAttitude);
+  for (const int first : layout.accel_bias_extra) bias(first, kErrVelocity);
+  for (const int first : layout.gyro_bias_extra) bias(first, kErrAttitude);
+  // Scale factor / misalignment (random constants): d(error of m) / d s_i = m_i e_i,
+  // d / d M_ij = m_j e_i, resolved in n by C_b_n (Groves 2nd ed. (4.17), (14.98)).
+  auto scale_misalignment = [&](int scale, int mis, int nav_rows, const Vector3d& m_b) {
+    if (scale < 0) return;
+    for (int i = 0; i < 3; ++i) set(scale + i, nav_rows, i, m_b[i]);
+    for (int k = 0; k < 6; ++k)
+      set(mis + k, nav_rows, kMisalignmentRow[k], m_b[kMisalignmentCol[k]]);
+  };
+  scale_misalignment(layout.gyro_scale, layout.gyro_misalignment, kErrAttitude, omega_ib_b);
+  scale_misalignment(layout.accel_scale, layout.accel_misalignment, kErrVelocity, f_ib_b);
 }
 
 ErrorStateMatrix ErrorStateProcessNoise(const ErrorStateNoise& noise) {
